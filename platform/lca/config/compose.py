@@ -1,0 +1,41 @@
+"""Compose the project's Hydra config outside `@hydra.main` and check its values."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from hydra import compose as hydra_compose
+from hydra import initialize_config_dir
+from omegaconf import DictConfig, OmegaConf
+
+from lca.config import schema
+from lca.config.schema import ConfigValueError
+
+ConfigError = ConfigValueError
+
+
+def conf_dir() -> Path:
+    """The `conf/` folder: $LCA_CONF_DIR, else the one beside `platform/` in this checkout."""
+    env = os.environ.get("LCA_CONF_DIR")
+    if env:
+        return Path(env).resolve()
+    return Path(__file__).resolve().parents[3] / "conf"
+
+
+def validate(cfg: DictConfig) -> None:
+    """Run every group's `check()`; raises ConfigError naming the bad key."""
+    obj = OmegaConf.to_object(cfg)
+    for group in vars(obj).values():
+        check = getattr(group, "check", None)
+        if callable(check):
+            check()
+
+
+def compose(overrides: list[str] | None = None, config_name: str = "config") -> DictConfig:
+    """Compose `conf/config.yaml` with Hydra overrides, then validate it."""
+    schema.register()
+    with initialize_config_dir(config_dir=str(conf_dir()), version_base="1.3"):
+        cfg = hydra_compose(config_name=config_name, overrides=list(overrides or []))
+    validate(cfg)
+    return cfg

@@ -1,0 +1,245 @@
+"""Typed schema of every config group; registered in Hydra's ConfigStore as `lca_schema`.
+
+A typo in a key or a wrong type fails when Hydra composes. Value checks (ranges, sums) live
+in `check()` methods that `lca.config.validate` runs right after composition.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from hydra.core.config_store import ConfigStore
+from omegaconf import MISSING
+
+TERRAIN_TYPES = ("flat", "stairs_up", "stairs_down", "uneven")
+
+
+class ConfigValueError(ValueError):
+    """A config value outside its allowed range; the message starts with the full key."""
+
+
+def _require(ok: bool, key: str, message: str) -> None:
+    if not ok:
+        raise ConfigValueError(f"{key}: {message}")
+
+
+def _check_range(key: str, lo_hi: list[float], low: float = 0.0) -> None:
+    _require(len(lo_hi) == 2, key, f"expected [low, high], got {list(lo_hi)}")
+    _require(lo_hi[0] >= low, key, f"must be >= {low}, got {list(lo_hi)}")
+    _require(lo_hi[0] <= lo_hi[1], key, f"low must not exceed high, got {list(lo_hi)}")
+
+
+@dataclass
+class SimConfig:
+    timestep: float = 0.005  # 200 Hz physics
+    decimation: int = 4  # 50 Hz policy
+    integrator: str = "implicitfast"
+    cone: str = "pyramidal"
+    iterations: int = 10  # bounded solver work per step
+    ls_iterations: int = 5
+    bvactive: bool = False  # MuJoCo's default (on) makes stepping ~3x slower
+    num_threads: int = 0  # mjbatch worker threads; 0 = every logical CPU
+
+    def check(self) -> None:
+        _require(self.timestep > 0, "sim.timestep", f"must be > 0, got {self.timestep}")
+        _require(self.decimation >= 1, "sim.decimation", f"must be >= 1, got {self.decimation}")
+        allowed = ("euler", "implicit", "implicitfast", "rk4")
+        _require(self.integrator in allowed, "sim.integrator", f"allowed: {allowed}")
+        _require(self.cone in ("pyramidal", "elliptic"), "sim.cone", "allowed: pyramidal, elliptic")
+        _require(self.iterations >= 1, "sim.iterations", f"must be >= 1, got {self.iterations}")
+
+
+@dataclass
+class ActuatorGroup:
+    joints: list[str] = MISSING  # regexes over joint names
+    rotor_inertia: list[float] = MISSING  # kg m^2 of each planetary stage, motor side first
+    gear_ratio: list[float] = MISSING  # ratio of each stage (first is 1)
+    motors: int = 1  # motors driving the joint through a linkage (ankles, waist roll/pitch: 2)
+    effort_limit: float = MISSING  # N m
+
+
+@dataclass
+class RobotConfig:
+    name: str = "g1"
+    # PD gains from armature: kp = I w^2, kd = 2 zeta I w (w = 2 pi f); stiff yet stable at 200 Hz
+    natural_frequency_hz: float = 10.0
+    damping_ratio: float = 2.0
+    actuators: dict[str, ActuatorGroup] = field(default_factory=dict)
+    home: dict[str, float] = field(default_factory=dict)  # joint name regex -> angle (rad)
+    home_base_height: float = 0.0  # 0: computed so the feet rest on the ground
+    collision_parts: list[str] = field(default_factory=lambda: ["feet", "legs"])
+    self_collision: bool = False
+    foot_friction: float = 1.0
+
+    def check(self) -> None:
+        for name, group in self.actuators.items():
+            key = f"robot.actuators.{name}"
+            _require(len(group.rotor_inertia) == len(group.gear_ratio), key, "stage counts differ")
+            _require(group.effort_limit > 0, f"{key}.effort_limit", "must be > 0")
+        allowed = ("feet", "legs", "torso", "arms")
+        for part in self.collision_parts:
+            _require(part in allowed, "robot.collision_parts", f"unknown '{part}'; allowed: {allowed}")
+        _require(self.natural_frequency_hz > 0, "robot.natural_frequency_hz", "must be > 0")
+        _require(self.damping_ratio > 0, "robot.damping_ratio", "must be > 0")
+
+
+@dataclass
+class TerrainMixture:
+    flat: float = 0.0
+    stairs_up: float = 0.0
+    stairs_down: float = 0.0
+    uneven: float = 0.0
+
+
+@dataclass
+class TerrainConfig:
+    name: str = "mixed"
+    mixture: TerrainMixture = field(default_factory=TerrainMixture)
+    rows: int = 4
+    cols: int = 4
+    tile_size: float = 8.0  # m, square tiles
+    resolution: float = 0.01  # m per heightfield sample; 1 cm keeps 0.31/0.23 m treads exact
+    border: float = 1.0  # m of flat ground around the whole grid
+    platform: float = 1.5  # m, flat square at each tile centre where the robot spawns
+    num_steps: int = 8  # steps per pyramid side (stairs_up / stairs_down)
+    block_size: float = 0.4  # m, side of a block of the uneven field
+    seed: int = 0
+
+    def check(self) -> None:
+        weights = [getattr(self.mixture, t) for t in TERRAIN_TYPES]
+        _require(min(weights) >= 0, "terrain.mixture", f"weights must be >= 0, got {weights}")
+        _require(
+            abs(sum(weights) - 1.0) < 1e-6,
+            "terrain.mixture",
+            f"weights must sum to 1, got {sum(weights):.6g} ({dict(zip(TERRAIN_TYPES, weights))})",
+        )
+        _require(self.rows >= 1 and self.cols >= 1, "terrain.rows/cols", "must be >= 1")
+        _require(self.resolution > 0, "terrain.resolution", "must be > 0")
+        for key in ("tile_size", "border", "platform", "block_size"):
+            value = getattr(self, key)
+            _require(
+                abs(value / self.resolution - round(value / self.resolution)) < 1e-6,
+                f"terrain.{key}",
+                f"{value} m is not a multiple of terrain.resolution={self.resolution}",
+            )
+        _require(self.platform < self.tile_size, "terrain.platform", "must be < tile_size")
+        _require(self.num_steps >= 1, "terrain.num_steps", f"must be >= 1, got {self.num_steps}")
+
+
+@dataclass
+class DifficultyConfig:
+    name: str = "medium"
+    stairs_riser: list[float] = field(default_factory=lambda: [0.14, 0.18])  # m
+    stairs_tread: float = 0.31  # m
+    uneven_height: list[float] = field(default_factory=lambda: [0.05, 0.20])  # m
+    height_noise: float = 0.10  # m, uniform noise on the actor's heightmap (task layer)
+
+    def check(self) -> None:
+        _check_range("difficulty.stairs_riser", self.stairs_riser)
+        _require(self.stairs_riser[0] > 0, "difficulty.stairs_riser", "must be > 0")
+        _require(self.stairs_tread > 0, "difficulty.stairs_tread", "must be > 0")
+        _check_range("difficulty.uneven_height", self.uneven_height)
+        _require(self.height_noise >= 0, "difficulty.height_noise", "must be >= 0")
+
+
+@dataclass
+class ResetConfig:
+    joint_pos_noise: float = 0.05  # rad, uniform
+    joint_vel_noise: float = 0.0
+    base_xy_noise: float = 0.1  # m, uniform around the tile centre
+    yaw_range: float = 3.14159  # rad, uniform spawn heading
+
+
+@dataclass
+class RandomizationConfig:
+    friction: list[float] = field(default_factory=lambda: [0.6, 1.25])
+    added_base_mass: list[float] = field(default_factory=lambda: [-1.0, 3.0])  # kg
+
+
+@dataclass
+class TaskConfig:
+    name: str = "locomotion"
+    num_envs: int = 256
+    episode_length_s: float = 20.0
+    reset: ResetConfig = field(default_factory=ResetConfig)
+    randomization: RandomizationConfig = field(default_factory=RandomizationConfig)
+    params: dict[str, Any] = field(default_factory=dict)
+
+    def check(self) -> None:
+        _require(self.num_envs >= 1, "task.num_envs", f"must be >= 1, got {self.num_envs}")
+        _check_range("task.randomization.friction", self.randomization.friction)
+        _check_range("task.randomization.added_base_mass", self.randomization.added_base_mass, -1e9)
+
+
+@dataclass
+class ActorConfig:
+    name: str = "mlp"
+    kind: str = "mlp"  # mlp | lstm
+    hidden_dims: list[int] = field(default_factory=lambda: [512, 256, 128])
+    activation: str = "elu"
+
+
+@dataclass
+class EncoderConfig:
+    name: str = "cnn"
+    kind: str = "cnn"  # cnn | mlp
+    hidden_dims: list[int] = field(default_factory=lambda: [256, 256])
+    kernel_size: int = 3
+    stride: int = 1
+
+
+@dataclass
+class CurriculumConfig:
+    name: str = "two"
+    perception_from: float = 0.5  # fraction of iterations after which the actor sees its map
+
+
+@dataclass
+class AlgoConfig:
+    name: str = "ppo"
+    params: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass
+class EvalConfig:
+    name: str = "default"
+    params: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass
+class LoggerConfig:
+    name: str = "tensorboard"
+
+
+@dataclass
+class ScaleConfig:
+    name: str = "cpu"
+    num_envs: int = 256
+    max_iterations: int = 100
+
+
+@dataclass
+class LcaConfig:
+    seed: int = 0
+    device: str = "cpu"  # torch device; "cuda" when a GPU exists
+    torch_threads: int = 0  # 0 = torch default
+    sim: SimConfig = field(default_factory=SimConfig)
+    robot: RobotConfig = field(default_factory=RobotConfig)
+    terrain: TerrainConfig = field(default_factory=TerrainConfig)
+    difficulty: DifficultyConfig = field(default_factory=DifficultyConfig)
+    task: TaskConfig = field(default_factory=TaskConfig)
+    actor: ActorConfig = field(default_factory=ActorConfig)
+    encoder: EncoderConfig = field(default_factory=EncoderConfig)
+    curriculum: CurriculumConfig = field(default_factory=CurriculumConfig)
+    algo: AlgoConfig = field(default_factory=AlgoConfig)
+    eval: EvalConfig = field(default_factory=EvalConfig)
+    logger: LoggerConfig = field(default_factory=LoggerConfig)
+    scale: ScaleConfig = field(default_factory=ScaleConfig)
+
+
+def register() -> None:
+    ConfigStore.instance().store(name="lca_schema", node=LcaConfig)
+
+
+register()
