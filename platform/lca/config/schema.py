@@ -71,6 +71,16 @@ class RobotConfig:
     collision_parts: list[str] = field(default_factory=lambda: ["feet", "legs"])
     self_collision: bool = False
     foot_friction: float = 1.0
+    # Sole contact spheres in the ankle-roll frame (toes, heels); the sole is at z = -0.035.
+    foot_spheres: list[list[float]] = field(
+        default_factory=lambda: [
+            [0.13, 0.026, -0.025],
+            [0.13, -0.026, -0.025],
+            [-0.05, 0.02, -0.025],
+            [-0.05, -0.02, -0.025],
+        ]
+    )
+    foot_sphere_radius: float = 0.01
 
     def check(self) -> None:
         for name, group in self.actuators.items():

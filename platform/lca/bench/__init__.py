@@ -1,0 +1,1 @@
+"""Benchmarks: `python -m lca.bench sim|env|train [--json] [hydra overrides]`."""

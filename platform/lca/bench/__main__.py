@@ -1,0 +1,29 @@
+"""Dispatch `python -m lca.bench <name> [--json] [overrides]` to a benchmark module."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import sys
+
+BENCHMARKS = ("sim",)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m lca.bench")
+    parser.add_argument("name", choices=BENCHMARKS)
+    parser.add_argument("--json", action="store_true", help="print one JSON object only")
+    parser.add_argument("overrides", nargs="*", help="Hydra overrides, e.g. terrain=flat")
+    args = parser.parse_args(argv)
+    module = importlib.import_module(f"lca.bench.{args.name}")
+    result = module.run(args.overrides, log=None if args.json else print)
+    if args.json:
+        print(json.dumps(result))
+    else:
+        print(module.table(result))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

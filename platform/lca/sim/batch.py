@@ -1,0 +1,96 @@
+"""N copies of the scene stepping in parallel native threads (mjbatch), with live numpy views.
+
+Environment i lives on terrain tile i % n_tiles and is reset to the `home` keyframe moved to
+that tile's centre, with noise. Friction and base mass can be set per environment.
+"""
+
+from __future__ import annotations
+
+import mjbatch
+import mujoco
+import numpy as np
+
+from lca.config.schema import ResetConfig
+from lca.sim import robot as g1
+from lca.sim.scene import Scene
+
+
+def yaw_quat(yaw: np.ndarray) -> np.ndarray:
+    """(N,) heading angles -> (N, 4) wxyz quaternions about +z."""
+    return np.stack([np.cos(yaw / 2), np.zeros_like(yaw), np.zeros_like(yaw), np.sin(yaw / 2)], -1)
+
+
+class BatchedSim:
+    """Live (N, ...) views: `qpos`, `qvel`, `ctrl`, `sensordata`, and `sensor(name)`."""
+
+    def __init__(self, scene: Scene, num_envs: int, num_threads: int = 0, seed: int = 0):
+        self.scene = scene
+        self.model = scene.model
+        self.num_envs = num_envs
+        self.batch = mjbatch.Batch(self.model, num_envs, num_threads=num_threads)
+        self.qpos = self.batch.bind("qpos")
+        self.qvel = self.batch.bind("qvel")
+        self.ctrl = self.batch.bind("ctrl")
+        self.qacc = self.batch.bind("qacc")
+        self.actuator_force = self.batch.bind("actuator_force")
+        self.sensordata = self.batch.bind("sensordata")
+        self.time = self.batch.bind("time")
+        self.rng = np.random.default_rng(seed)
+        centres = scene.terrain.tile_centres()
+        self.env_tile = np.arange(num_envs) % len(centres)
+        self.env_origin = centres[self.env_tile]
+        self._friction = None
+        self._body_mass = None
+        self._nominal_friction = self.model.geom_friction[:, 0].copy()
+        self._nominal_mass = self.model.body_mass.copy()
+        self.base_body = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, g1.BASE_BODY)
+
+    def sensor(self, name: str) -> np.ndarray:
+        return self.batch.sensor(name)
+
+    def step(self, nstep: int = 1, ids: np.ndarray | None = None) -> None:
+        self.batch.step(ids, nstep=nstep)
+
+    def forward(self, ids: np.ndarray | None = None) -> None:
+        self.batch.forward(ids)
+
+    def reset(self, ids: np.ndarray | None = None, noise: ResetConfig | None = None) -> None:
+        """Reset `ids` (all if None) to `home` on their own tile, with uniform noise."""
+        ids = np.arange(self.num_envs) if ids is None else np.asarray(ids, dtype=np.int64)
+        if ids.size == 0:
+            return
+        self.batch.reset(ids, keyframe=self.scene.home_key)
+        n = ids.size
+        xy = self.env_origin[ids].copy()
+        yaw = np.zeros(n)
+        joints = np.tile(self.scene.home_joint_pos, (n, 1))
+        if noise is not None:
+            xy += self.rng.uniform(-noise.base_xy_noise, noise.base_xy_noise, (n, 2))
+            yaw = self.rng.uniform(-noise.yaw_range, noise.yaw_range, n)
+            joints += self.rng.uniform(-noise.joint_pos_noise, noise.joint_pos_noise, joints.shape)
+        ground = self.scene.terrain.height_at(xy[:, 0], xy[:, 1])
+        qpos = self.qpos[ids]
+        qpos[:, :2] = xy
+        qpos[:, 2] = ground + self.scene.base_height
+        qpos[:, 3:7] = yaw_quat(yaw)
+        qpos[:, 7:] = joints
+        self.qpos[ids] = qpos
+        if noise is not None and noise.joint_vel_noise > 0:
+            qvel = self.qvel[ids]
+            qvel[:, 6:] = self.rng.uniform(-noise.joint_vel_noise, noise.joint_vel_noise, (n, 29))
+            self.qvel[ids] = qvel
+        self.ctrl[ids] = self.scene.home_joint_pos
+        self.batch.forward(ids)
+
+    def set_friction_scale(self, ids: np.ndarray, scale: np.ndarray) -> None:
+        """Sliding friction of every geom of env i = nominal * scale[i]."""
+        if self._friction is None:
+            self._friction = self.batch.expand("geom_friction")
+        self._friction[ids, :, 0] = self._nominal_friction[None, :] * np.asarray(scale)[:, None]
+
+    def set_added_base_mass(self, ids: np.ndarray, added: np.ndarray) -> None:
+        """Pelvis mass of env i = nominal + added[i] kg; derived constants are recomputed."""
+        if self._body_mass is None:
+            self._body_mass = self.batch.expand("body_mass")
+        self._body_mass[ids, self.base_body] = self._nominal_mass[self.base_body] + added
+        self.batch.set_const(np.asarray(ids))

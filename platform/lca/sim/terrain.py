@@ -1,0 +1,140 @@
+"""Procedural terrain: a grid of square tiles (flat, stairs up/down, uneven blocks) as one
+heightfield array, with an exact vectorised height query.
+
+Stairs are square pyramids around the tile centre. `stairs_up` is a pit: the robot spawns on
+the bottom platform and climbs outwards in any direction; `stairs_down` is a hill it descends.
+Every tile's outer ring is at height 0, so neighbouring tiles meet without a cliff.
+Risers are drawn once per tile (a real flight has equal risers), uniformly in the difficulty's
+range; the tread is the difficulty's depth.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from lca.config.schema import TERRAIN_TYPES, DifficultyConfig, TerrainConfig
+
+
+@dataclass
+class Tile:
+    kind: str
+    row: int
+    col: int
+    centre: tuple[float, float]  # world x, y
+    params: dict[str, float] = field(default_factory=dict)
+
+
+@dataclass
+class Terrain:
+    """Heights on a regular grid: `heights[r, c]` is at x = x0 + c*res, y = y0 + r*res."""
+
+    heights: np.ndarray
+    resolution: float
+    origin: tuple[float, float]
+    tiles: list[Tile]
+
+    @property
+    def size(self) -> tuple[float, float]:
+        """World extent (x, y) in metres."""
+        nrow, ncol = self.heights.shape
+        return (ncol - 1) * self.resolution, (nrow - 1) * self.resolution
+
+    @property
+    def centre(self) -> tuple[float, float]:
+        sx, sy = self.size
+        return self.origin[0] + sx / 2, self.origin[1] + sy / 2
+
+    def tile_centres(self) -> np.ndarray:
+        return np.array([t.centre for t in self.tiles])
+
+    def height_at(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Surface height at world points, exactly as MuJoCo's heightfield triangulates it.
+
+        Each grid cell is split along the diagonal from sample (r, c) to (r+1, c+1); points
+        outside the grid are clamped to its edge.
+        """
+        x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
+        nrow, ncol = self.heights.shape
+        u = np.clip((x - self.origin[0]) / self.resolution, 0, ncol - 1)
+        v = np.clip((y - self.origin[1]) / self.resolution, 0, nrow - 1)
+        c = np.minimum(np.floor(u).astype(np.int64), ncol - 2)
+        r = np.minimum(np.floor(v).astype(np.int64), nrow - 2)
+        fx, fy = u - c, v - r
+        h = self.heights
+        h00, h01, h10, h11 = h[r, c], h[r, c + 1], h[r + 1, c], h[r + 1, c + 1]
+        lower = fx >= fy  # triangle (r,c), (r,c+1), (r+1,c+1)
+        return np.where(
+            lower,
+            h00 + fx * (h01 - h00) + fy * (h11 - h01),
+            h00 + fy * (h10 - h00) + fx * (h11 - h10),
+        )
+
+
+def tile_kinds(cfg: TerrainConfig, rng: np.random.Generator) -> list[str]:
+    """Tile types in proportion to the mixture weights (largest remainder), shuffled."""
+    n = cfg.rows * cfg.cols
+    weights = np.array([getattr(cfg.mixture, t) for t in TERRAIN_TYPES], float)
+    exact = weights / weights.sum() * n
+    counts = np.floor(exact).astype(int)
+    for i in np.argsort(-(exact - counts), kind="stable")[: n - counts.sum()]:
+        counts[i] += 1
+    kinds = [t for t, k in zip(TERRAIN_TYPES, counts, strict=True) for _ in range(k)]
+    return [kinds[i] for i in rng.permutation(n)]
+
+
+def _stairs(lx, ly, cfg, riser, tread, up: bool) -> np.ndarray:
+    """Square pyramid of `num_steps` steps outside the central platform; outer ring at 0."""
+    ring = np.maximum(np.abs(lx), np.abs(ly)) - cfg.platform / 2
+    # Index of the step a point stands on: 0 on the platform, num_steps on the outer ring.
+    # The small offset keeps points exactly on a step edge on the outer step.
+    step = np.clip(np.floor(ring / tread + 1e-9) + 1, 0, cfg.num_steps)
+    step = np.where(ring < 0, 0, step)
+    levels_below_top = cfg.num_steps - step
+    return -riser * levels_below_top if up else riser * levels_below_top
+
+
+def _blocks(lx, ly, cfg, low, high, rng) -> np.ndarray:
+    """Random block field; the spawn platform is one flat block."""
+    half = cfg.tile_size / 2
+    nb = int(round(cfg.tile_size / cfg.block_size))
+    block_heights = rng.uniform(low, high, size=(nb, nb))
+    bi = np.clip(((ly + half) / cfg.block_size).astype(int), 0, nb - 1)
+    bj = np.clip(((lx + half) / cfg.block_size).astype(int), 0, nb - 1)
+    h = block_heights[bi, bj]
+    on_platform = np.maximum(np.abs(lx), np.abs(ly)) <= cfg.platform / 2
+    return np.where(on_platform, (low + high) / 2, h)
+
+
+def generate(cfg: TerrainConfig, difficulty: DifficultyConfig, seed: int | None = None) -> Terrain:
+    """Build the whole tile grid. Deterministic in (config, difficulty, seed)."""
+    rng = np.random.default_rng(cfg.seed if seed is None else seed)
+    res = cfg.resolution
+    tile_n = int(round(cfg.tile_size / res))
+    border_n = int(round(cfg.border / res))
+    nrow = cfg.rows * tile_n + 2 * border_n + 1
+    ncol = cfg.cols * tile_n + 2 * border_n + 1
+    heights = np.zeros((nrow, ncol))
+    origin = (-cfg.border, -cfg.border)
+    local = (np.arange(tile_n) - tile_n / 2) * res  # sample offsets from a tile centre
+    ly, lx = np.meshgrid(local, local, indexing="ij")
+    tiles = []
+    for index, kind in enumerate(tile_kinds(cfg, rng)):
+        row, col = divmod(index, cfg.cols)
+        centre = ((col + 0.5) * cfg.tile_size, (row + 0.5) * cfg.tile_size)
+        params: dict[str, float] = {}
+        if kind in ("stairs_up", "stairs_down"):
+            riser = float(rng.uniform(*difficulty.stairs_riser))
+            params = {"riser": riser, "tread": difficulty.stairs_tread}
+            h = _stairs(lx, ly, cfg, riser, difficulty.stairs_tread, up=kind == "stairs_up")
+        elif kind == "uneven":
+            low, high = difficulty.uneven_height
+            params = {"low": low, "high": high}
+            h = _blocks(lx, ly, cfg, low, high, rng)
+        else:
+            h = np.zeros_like(lx)
+        r0, c0 = border_n + row * tile_n, border_n + col * tile_n
+        heights[r0 : r0 + tile_n, c0 : c0 + tile_n] = h
+        tiles.append(Tile(kind, row, col, centre, params))
+    return Terrain(heights=heights, resolution=res, origin=origin, tiles=tiles)
