@@ -34,8 +34,10 @@ def main(argv: list[str] | None = None) -> int:
     out = Path(outs[0].split("=", 1)[1])
     path = export([a for a in args if not a.startswith("out=")], out)
     model = mujoco.MjModel.from_binary_path(str(path))
-    print(f"wrote {path} ({path.stat().st_size / 1e6:.1f} MB): nq={model.nq} nu={model.nu} "
-          f"hfield {model.hfield_nrow[0]}x{model.hfield_ncol[0]}")
+    print(
+        f"wrote {path} ({path.stat().st_size / 1e6:.1f} MB): nq={model.nq} nu={model.nu} "
+        f"hfield {model.hfield_nrow[0]}x{model.hfield_ncol[0]}"
+    )
     return 0
 
 

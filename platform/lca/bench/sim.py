@@ -67,8 +67,10 @@ def run(overrides: list[str], log: Callable[[str], None] | None = print) -> dict
             steps = batched_rate(scene, num_envs, threads, decimation)
             rows.append({"num_envs": num_envs, "threads": threads, "steps_per_s": steps})
             if log:
-                log(f"mjbatch N={num_envs:5d} threads={threads}: {steps:,.0f} steps/s "
-                    f"({steps / single:.2f}x single)")
+                log(
+                    f"mjbatch N={num_envs:5d} threads={threads}: {steps:,.0f} steps/s "
+                    f"({steps / single:.2f}x single)"
+                )
     return {"single_steps_per_s": single, "batched": rows}
 
 

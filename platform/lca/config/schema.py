@@ -89,7 +89,9 @@ class RobotConfig:
             _require(group.effort_limit > 0, f"{key}.effort_limit", "must be > 0")
         allowed = ("feet", "legs", "torso", "arms")
         for part in self.collision_parts:
-            _require(part in allowed, "robot.collision_parts", f"unknown '{part}'; allowed: {allowed}")
+            _require(
+                part in allowed, "robot.collision_parts", f"unknown '{part}'; allowed: {allowed}"
+            )
         _require(self.natural_frequency_hz > 0, "robot.natural_frequency_hz", "must be > 0")
         _require(self.damping_ratio > 0, "robot.damping_ratio", "must be > 0")
 
@@ -163,8 +165,55 @@ class ResetConfig:
 
 @dataclass
 class RandomizationConfig:
-    friction: list[float] = field(default_factory=lambda: [0.6, 1.25])
-    added_base_mass: list[float] = field(default_factory=lambda: [-1.0, 3.0])  # kg
+    enabled: bool = True
+    friction: list[float] = field(default_factory=lambda: [0.6, 1.25])  # scale, per reset
+    added_base_mass: list[float] = field(default_factory=lambda: [-1.0, 3.0])  # kg, at start
+    push_interval_s: float = 8.0  # s between pushes; 0 disables
+    push_velocity: float = 0.5  # m/s, uniform planar base velocity kick
+
+
+@dataclass
+class ObservationConfig:
+    history: int = 5  # K proprioception frames, newest first
+    noise: bool = True  # actor observation noise on/off
+    height_dropout: float = 0.05  # fraction of actor heightmap cells dropped (set to the mean)
+    actor_grid: list[int] = field(default_factory=lambda: [11, 11])
+    actor_spacing: float = 0.1  # m: 11 x 11 cells over 1.0 m x 1.0 m
+    critic_grid: list[int] = field(default_factory=lambda: [16, 16])
+    critic_spacing: float = 0.1  # m: 16 x 16 cells over 1.5 m x 1.5 m
+
+
+@dataclass
+class CommandConfig:
+    lin_vel_x: list[float] = field(default_factory=lambda: [-0.6, 0.6])  # m/s
+    lin_vel_y: list[float] = field(default_factory=lambda: [-0.3, 0.3])  # m/s
+    ang_vel_z: list[float] = field(default_factory=lambda: [-0.5, 0.5])  # rad/s
+    standing_fraction: float = 0.1  # share of commands that are exactly zero
+    resample_time_s: float = 10.0
+    standing_epsilon: float = 5e-3  # ||u|| below this is a standing command (paper)
+
+
+@dataclass
+class RewardParams:
+    tracking_sigma: float = 0.25  # exp(-err^2 / 0.25) (paper)
+    gait_period: float = 0.8  # s (paper)
+    stance_fraction: float = 0.55  # tau (paper)
+    contact_threshold: float = 1.0  # N (paper F*)
+    strike_threshold: float = 100.0  # N of lateral foot force that counts as a strike (paper)
+    base_height_target: float = 0.77  # m above the ground (paper)
+    swing_height: float = 0.08  # m, nominal swing clearance of the sole
+    stand_height: float = 0.0  # m, target when standing: the sole site is on the sole
+    clearance_scale: float = 0.08  # m, h_scale normalising the clearance error
+    clearance_gate: float = 10.0  # kappa in tanh(kappa * |v_xy|)
+    flat_feet_k: float = 25.0  # k_theta (paper)
+    soft_limit_factor: float = 0.95  # joint range share inside which dof_pos_limits is zero
+
+
+@dataclass
+class TerminationConfig:
+    min_base_height: float = 0.35  # m above the ground
+    max_tilt: float = 1.0  # rad between base z-axis and world z
+    max_joint_vel: float = 1000.0  # rad/s; above this the state counts as non-finite
 
 
 @dataclass
@@ -172,14 +221,38 @@ class TaskConfig:
     name: str = "locomotion"
     num_envs: int = 256
     episode_length_s: float = 20.0
+    action_scale: float = 0.25  # rad per unit action around the default pose
+    action_clip: float = 10.0
+    perception: bool = True  # False: the actor's heightmap is exactly zero
     reset: ResetConfig = field(default_factory=ResetConfig)
     randomization: RandomizationConfig = field(default_factory=RandomizationConfig)
-    params: dict[str, Any] = field(default_factory=dict)
+    observations: ObservationConfig = field(default_factory=ObservationConfig)
+    commands: CommandConfig = field(default_factory=CommandConfig)
+    rewards: dict[str, float] = field(default_factory=dict)
+    reward_params: RewardParams = field(default_factory=RewardParams)
+    terminations: TerminationConfig = field(default_factory=TerminationConfig)
 
     def check(self) -> None:
         _require(self.num_envs >= 1, "task.num_envs", f"must be >= 1, got {self.num_envs}")
         _check_range("task.randomization.friction", self.randomization.friction)
         _check_range("task.randomization.added_base_mass", self.randomization.added_base_mass, -1e9)
+        _require(self.observations.history >= 1, "task.observations.history", "must be >= 1")
+        _require(
+            0 <= self.observations.height_dropout < 1, "task.observations.height_dropout", "[0, 1)"
+        )
+        for key in ("lin_vel_x", "lin_vel_y", "ang_vel_z"):
+            _check_range(f"task.commands.{key}", getattr(self.commands, key), -1e9)
+        _require(
+            0 <= self.commands.standing_fraction <= 1, "task.commands.standing_fraction", "[0, 1]"
+        )
+        from lca.task.rewards import REWARD_TERMS  # task layer owns the names
+
+        for name in self.rewards:
+            _require(
+                name in REWARD_TERMS,
+                f"task.rewards.{name}",
+                f"unknown reward term; allowed: {sorted(REWARD_TERMS)}",
+            )
 
 
 @dataclass

@@ -30,6 +30,8 @@ FEET = ("left", "right")
 FOOT_BODY = "{side}_ankle_roll_link"
 FOOT_SITE = "{side}_foot"
 IMU_SITE = "imu_in_pelvis"
+# Leg bodies whose contact with anything is undesired (hip, thigh, shin).
+UNDESIRED_CONTACT_BODIES = ("hip_roll_link", "hip_yaw_link", "knee_link")
 BASE_BODY = "pelvis"
 
 COLLISION_PARTS = {
@@ -109,7 +111,9 @@ def _add_sensors(spec: mujoco.MjSpec) -> None:
     for existing in list(spec.sensors):
         spec.delete(existing)
     spec.add_sensor(name="imu_ang_vel", type=sens.mjSENS_GYRO, objtype=site, objname=IMU_SITE)
-    spec.add_sensor(name="imu_lin_vel", type=sens.mjSENS_VELOCIMETER, objtype=site, objname=IMU_SITE)
+    spec.add_sensor(
+        name="imu_lin_vel", type=sens.mjSENS_VELOCIMETER, objtype=site, objname=IMU_SITE
+    )
     # World z-axis expressed in the IMU frame; projected gravity is its negative.
     spec.add_sensor(
         name="imu_up",
@@ -146,6 +150,14 @@ def _add_sensors(spec: mujoco.MjSpec) -> None:
         spec.add_sensor(
             name=f"{side}_foot_quat", type=sens.mjSENS_FRAMEQUAT, objtype=site, objname=foot_site
         )
+        for part in UNDESIRED_CONTACT_BODIES:
+            spec.add_sensor(
+                name=f"{side}_{part}_contact",
+                type=sens.mjSENS_CONTACT,
+                objtype=mujoco.mjtObj.mjOBJ_BODY,
+                objname=f"{side}_{part}",
+                intprm=[3, 3, 1],
+            )
 
 
 def _add_foot_spheres(spec: mujoco.MjSpec, cfg: RobotConfig) -> None:
@@ -187,7 +199,11 @@ def build_robot_spec(cfg: RobotConfig) -> mujoco.MjSpec:
     for joint in joints:
         row = table[joint.name]
         joint.armature = row["armature"]
-        joint.damping = [0.0, 0.0, 0.0]  # damping comes from the PD actuator (kd), integrated implicitly
+        joint.damping = [
+            0.0,
+            0.0,
+            0.0,
+        ]  # damping comes from the PD actuator (kd), integrated implicitly
         joint.actfrclimited = mujoco.mjtLimited.mjLIMITED_TRUE
         joint.actfrcrange = [-row["effort_limit"], row["effort_limit"]]
     for actuator in spec.actuators:

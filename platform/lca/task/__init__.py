@@ -1,0 +1,1 @@
+"""Task layer: observations, commands, rewards and terminations as an rsl-rl VecEnv."""

@@ -1,0 +1,50 @@
+"""Planar velocity commands and the gait phase clock."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from lca.config.schema import CommandConfig
+
+
+class VelocityCommand:
+    """u = (u_x, u_y, u_yaw) per env, resampled every `resample_time_s`; a configured share
+    of commands is exactly zero (standing)."""
+
+    def __init__(self, cfg: CommandConfig, num_envs: int, dt: float, rng: np.random.Generator):
+        self.cfg = cfg
+        self.dt = dt
+        self.rng = rng
+        self.value = np.zeros((num_envs, 3))
+        self.time_left = np.zeros(num_envs)
+
+    @property
+    def standing(self) -> np.ndarray:
+        return np.linalg.norm(self.value, axis=1) < self.cfg.standing_epsilon
+
+    def resample(self, ids: np.ndarray) -> None:
+        n = len(ids)
+        if n == 0:
+            return
+        c = self.cfg
+        value = np.stack(
+            [
+                self.rng.uniform(*c.lin_vel_x, n),
+                self.rng.uniform(*c.lin_vel_y, n),
+                self.rng.uniform(*c.ang_vel_z, n),
+            ],
+            axis=1,
+        )
+        value[self.rng.random(n) < c.standing_fraction] = 0.0
+        self.value[ids] = value
+        self.time_left[ids] = c.resample_time_s
+
+    def update(self) -> None:
+        self.time_left -= self.dt
+        self.resample(np.flatnonzero(self.time_left <= 0))
+
+
+def gait_phase(episode_time: np.ndarray, period: float) -> np.ndarray:
+    """(N, 2) phase in [0, 1) of the left and right foot, half a period apart."""
+    phi = np.mod(episode_time / period, 1.0)
+    return np.stack([phi, np.mod(phi + 0.5, 1.0)], axis=1)

@@ -1,0 +1,282 @@
+"""The locomotion task as an rsl-rl-lib 5.x `VecEnv` over the batched MuJoCo simulation.
+
+Observation groups (TensorDict, batch [N]):
+  policy         K-frame noisy proprioception history, command, last action, gait phase
+  height         (N, 1, 11, 11) noisy, sparse actor map; exactly zero when perception is off
+  critic         the same proprioception without noise, plus base linear velocity
+  critic_height  (N, 1, 16, 16) noiseless privileged map
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import torch
+from omegaconf import DictConfig
+from rsl_rl.env import VecEnv
+from tensordict import TensorDict
+
+from lca.sim.batch import BatchedSim
+from lca.sim.scene import Scene, build_scene
+from lca.task import heightmap, observations
+from lca.task.commands import VelocityCommand, gait_phase
+from lca.task.rewards import RewardContext, compute_rewards
+from lca.task.state import ContactAccumulator, RobotState, read_state, yaw_of
+from lca.task.terminations import fell, non_finite
+
+BAD_STATE_WARNINGS = [
+    int(w)
+    for w in (
+        mujoco.mjtWarning.mjWARN_BADQPOS,
+        mujoco.mjtWarning.mjWARN_BADQVEL,
+        mujoco.mjtWarning.mjWARN_BADQACC,
+    )
+]
+
+
+def joint_ids(names: list[str], *patterns: str) -> np.ndarray:
+    return np.array([i for i, n in enumerate(names) if any(p in n for p in patterns)], dtype=int)
+
+
+class LocomotionEnv(VecEnv):
+    def __init__(self, cfg: DictConfig, scene: Scene | None = None):
+        self.cfg = cfg
+        task = cfg.task
+        self.task_cfg = task
+        self.device = torch.device(cfg.device)
+        self.num_envs = int(task.num_envs)
+        self.scene = scene if scene is not None else build_scene(cfg)
+        self.sim = BatchedSim(self.scene, self.num_envs, cfg.sim.num_threads, seed=cfg.seed)
+        self.rng = np.random.default_rng(cfg.seed + 1)
+        self.decimation = int(cfg.sim.decimation)
+        self.dt = cfg.sim.timestep * self.decimation
+        self.max_episode_length = int(round(task.episode_length_s / self.dt))
+        names = self.scene.joint_names
+        self.num_actions = len(names)
+        self.default_joint_pos = self.scene.home_joint_pos.copy()
+        self.hip_ids = joint_ids(names, "hip_roll", "hip_yaw")
+        self.arm_ids = joint_ids(names, "shoulder", "elbow", "wrist")
+        self.torso_ids = joint_ids(names, "waist")
+        lower, upper = self.scene.model.jnt_range[1:].T
+        mid, half = (lower + upper) / 2, (upper - lower) / 2 * task.reward_params.soft_limit_factor
+        self.joint_lower, self.joint_upper = mid - half, mid + half
+        self.weights = {k: float(v) for k, v in task.rewards.items()}
+        self.perception = bool(task.perception)
+        self.height_noise = float(cfg.difficulty.height_noise) if task.observations.noise else 0.0
+
+        obs = task.observations
+        self.history_terms = observations.history_terms(self.num_actions)
+        self.current_terms = observations.current_terms(self.num_actions)
+        frame_dim = sum(t.dim for t in self.history_terms)
+        self.history = observations.History(self.num_envs, obs.history, frame_dim)
+        self.critic_history = observations.History(self.num_envs, obs.history, frame_dim)
+        self.actor_grid = tuple(obs.actor_grid)
+        self.critic_grid = tuple(obs.critic_grid)
+        self.actor_offsets = heightmap.grid_offsets(self.actor_grid, obs.actor_spacing)
+        self.critic_offsets = heightmap.grid_offsets(self.critic_grid, obs.critic_spacing)
+
+        self.commands = VelocityCommand(task.commands, self.num_envs, self.dt, self.rng)
+        self.contacts = ContactAccumulator(self.sim)
+        self.warnings = self.sim.batch.bind("warning")
+        self.episode_length_buf = torch.zeros(self.num_envs, dtype=torch.long, device=self.device)
+        self._episode_steps = np.zeros(self.num_envs, dtype=np.int64)
+        self.action = np.zeros((self.num_envs, self.num_actions))
+        self.last_action = np.zeros_like(self.action)
+        self.episode_sums: dict[str, np.ndarray] = {
+            k: np.zeros(self.num_envs) for k in self.weights
+        }
+        self.nonfinite_resets = 0
+        self._push_steps = (
+            int(round(task.randomization.push_interval_s / self.dt))
+            if task.randomization.enabled
+            else 0
+        )
+        if task.randomization.enabled:
+            all_ids = np.arange(self.num_envs)
+            mass = self.rng.uniform(*task.randomization.added_base_mass, self.num_envs)
+            self.sim.set_added_base_mass(all_ids, mass)
+        self._reset_envs(np.arange(self.num_envs))
+        self._obs = self._observe(read_state(self.sim, self.contacts))
+
+    # ---- rsl-rl VecEnv -------------------------------------------------------------------
+    def get_observations(self) -> TensorDict:
+        return self._obs
+
+    def step(self, actions: torch.Tensor) -> tuple[TensorDict, torch.Tensor, torch.Tensor, dict]:
+        clip = self.task_cfg.action_clip
+        self.last_action = self.action
+        self.action = np.clip(actions.detach().cpu().numpy().astype(np.float64), -clip, clip)
+        self.sim.ctrl[:] = self.default_joint_pos + self.task_cfg.action_scale * self.action
+        bad_before = ~np.isfinite(self.sim.qpos).all(1) | ~np.isfinite(self.sim.qvel).all(1)
+        warnings_before = self._bad_state_warnings()
+        self.contacts.clear()
+        for _ in range(self.decimation):
+            self.sim.step()
+            self.contacts.update()
+        self._episode_steps += 1
+        self._maybe_push()
+        self.commands.update()
+
+        state = read_state(self.sim, self.contacts)
+        broken = bad_before | (self._bad_state_warnings() > warnings_before)
+        broken |= non_finite(state, self.task_cfg.terminations.max_joint_vel)
+        state = _sanitise(state, broken)
+        fallen = fell(state, self.task_cfg.terminations) & ~broken
+        terminated = fallen | broken
+        time_out = (self._episode_steps >= self.max_episode_length) & ~terminated
+
+        ctx = self._reward_context(state, terminated)
+        reward, terms = compute_rewards(ctx, self.weights, self.dt)
+        for name, value in terms.items():
+            self.episode_sums[name] += value
+
+        done = terminated | time_out
+        extras = {"time_outs": torch.as_tensor(time_out, device=self.device), "log": {}}
+        done_ids = np.flatnonzero(done)
+        if done_ids.size:
+            extras["log"] = self._episode_log(done_ids, fallen, time_out)
+        self.nonfinite_resets += int(broken.sum())
+        extras["log"]["Episode_Termination/nonfinite_total"] = float(self.nonfinite_resets)
+        self._reset_envs(done_ids)
+        if done_ids.size:
+            state = _replace_rows(state, read_state(self.sim, self.contacts), done_ids)
+        self._obs = self._observe(state, reset_ids=done_ids)
+        self.episode_length_buf = torch.as_tensor(self._episode_steps, device=self.device)
+        return (
+            self._obs,
+            torch.as_tensor(reward, dtype=torch.float32, device=self.device),
+            torch.as_tensor(done, dtype=torch.long, device=self.device),
+            extras,
+        )
+
+    # ---- internals -----------------------------------------------------------------------
+    def _bad_state_warnings(self) -> np.ndarray:
+        return self.warnings[:, BAD_STATE_WARNINGS, 0].sum(axis=1)
+
+    def _reset_envs(self, ids: np.ndarray) -> None:
+        if ids.size == 0:
+            return
+        self.sim.reset(ids, self.task_cfg.reset)
+        rand = self.task_cfg.randomization
+        if rand.enabled:
+            self.sim.set_friction_scale(ids, self.rng.uniform(*rand.friction, ids.size))
+        self.commands.resample(ids)
+        self._episode_steps[ids] = 0
+        self.action[ids] = 0.0
+        self.last_action[ids] = 0.0
+        for sums in self.episode_sums.values():
+            sums[ids] = 0.0
+        self.contacts.clear()
+        self._fresh = ids
+
+    def _maybe_push(self) -> None:
+        if self._push_steps <= 0:
+            return
+        due = np.flatnonzero((self._episode_steps % self._push_steps) == 0)
+        if due.size:
+            v = self.task_cfg.randomization.push_velocity
+            qvel = self.sim.qvel[due]
+            qvel[:, :2] += self.rng.uniform(-v, v, (due.size, 2))
+            self.sim.qvel[due] = qvel
+
+    def _phase(self) -> np.ndarray:
+        period = self.task_cfg.reward_params.gait_period
+        return gait_phase(self._episode_steps * self.dt, period)
+
+    def _reward_context(self, state: RobotState, terminated: np.ndarray) -> RewardContext:
+        return RewardContext(
+            state=state,
+            command=self.commands.value,
+            standing=self.commands.standing,
+            phase=self._phase(),
+            action=self.action,
+            last_action=self.last_action,
+            default_joint_pos=self.default_joint_pos,
+            joint_lower=self.joint_lower,
+            joint_upper=self.joint_upper,
+            hip_ids=self.hip_ids,
+            arm_ids=self.arm_ids,
+            torso_ids=self.torso_ids,
+            terminated=terminated,
+            params=self.task_cfg.reward_params,
+        )
+
+    def _episode_log(self, ids: np.ndarray, fallen: np.ndarray, time_out: np.ndarray) -> dict:
+        log = {
+            f"Episode_Reward/{name}": float(sums[ids].mean())
+            for name, sums in self.episode_sums.items()
+        }
+        log["Episode_Termination/fall"] = float(fallen[ids].mean())
+        log["Episode_Termination/time_out"] = float(time_out[ids].mean())
+        return log
+
+    def _observe(self, state: RobotState, reset_ids: np.ndarray | None = None) -> TensorDict:
+        n = self.num_envs
+        frame = observations.history_frame(
+            state,
+            self.default_joint_pos,
+            self.history_terms,
+            self.rng if self.task_cfg.observations.noise else None,
+        )
+        clean = observations.history_frame(state, self.default_joint_pos, self.history_terms, None)
+        self.history.push(frame)
+        self.critic_history.push(clean)
+        fresh = np.arange(n) if reset_ids is None else reset_ids
+        self.history.fill(fresh, frame)
+        self.critic_history.fill(fresh, clean)
+
+        standing = self.commands.standing
+        current = np.concatenate(
+            [
+                self.commands.value * np.array([2.0, 2.0, 0.25]),
+                self.action,
+                observations.phase_features(self._phase(), standing),
+            ],
+            axis=1,
+        )
+        yaw = yaw_of(state.base_quat)
+        xy = state.base_pos[:, :2]
+        terrain = self.scene.terrain
+        if self.perception:
+            raw = heightmap.sample_heights(terrain, xy, yaw, self.actor_offsets)
+            drop = self.task_cfg.observations.height_dropout
+            actor_map = heightmap.actor_map(raw, self.height_noise, drop, self.rng)
+        else:
+            actor_map = np.zeros((n, self.actor_offsets.shape[0]))
+        critic_raw = heightmap.sample_heights(terrain, xy, yaw, self.critic_offsets)
+        critic_map = heightmap.normalise(critic_raw)
+        groups = {
+            "policy": np.concatenate([self.history.flat(), current], axis=1),
+            "height": actor_map.reshape(n, 1, *self.actor_grid),
+            "critic": np.concatenate(
+                [self.critic_history.flat(), current, state.base_lin_vel], axis=1
+            ),
+            "critic_height": critic_map.reshape(n, 1, *self.critic_grid),
+        }
+        return TensorDict(
+            {
+                k: torch.as_tensor(v, dtype=torch.float32, device=self.device)
+                for k, v in groups.items()
+            },
+            batch_size=[n],
+            device=self.device,
+        )
+
+    def set_perception(self, on: bool) -> None:
+        """Curriculum switch: when off the actor's map is exactly zero; the critic keeps its map."""
+        self.perception = bool(on)
+
+
+def _sanitise(state: RobotState, broken: np.ndarray) -> RobotState:
+    if not broken.any():
+        return state
+    for name, value in vars(state).items():
+        value[broken] = 0.0
+        setattr(state, name, np.nan_to_num(value, nan=0.0, posinf=0.0, neginf=0.0))
+    return state
+
+
+def _replace_rows(state: RobotState, fresh: RobotState, ids: np.ndarray) -> RobotState:
+    for name, value in vars(state).items():
+        value[ids] = getattr(fresh, name)[ids]
+    return state

@@ -1,0 +1,118 @@
+"""What the task reads from the simulation each policy step, as plain numpy arrays.
+
+Contact quantities are maxima over the physics substeps of one policy step, so a short
+impact between two policy steps still counts.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from lca.sim import robot as g1
+from lca.sim.batch import BatchedSim
+
+
+def quat_to_mat(q: np.ndarray) -> np.ndarray:
+    """(..., 4) wxyz -> (..., 3, 3)."""
+    w, x, y, z = np.moveaxis(q, -1, 0)
+    return np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+        ],
+        -2,
+    )
+
+
+def yaw_of(q: np.ndarray) -> np.ndarray:
+    w, x, y, z = np.moveaxis(q, -1, 0)
+    return np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+
+
+def pitch_of(q: np.ndarray) -> np.ndarray:
+    """Pitch (rad) of a frame's x-axis out of the horizontal plane."""
+    m = quat_to_mat(q)
+    return np.arctan2(-m[..., 2, 0], np.hypot(m[..., 0, 0], m[..., 1, 0]))
+
+
+@dataclass
+class RobotState:
+    base_pos: np.ndarray  # (N, 3) world
+    base_quat: np.ndarray  # (N, 4) wxyz
+    base_lin_vel: np.ndarray  # (N, 3) body frame
+    base_ang_vel: np.ndarray  # (N, 3) body frame
+    projected_gravity: np.ndarray  # (N, 3) unit gravity in the body frame
+    base_height: np.ndarray  # (N,) above the terrain under the base
+    joint_pos: np.ndarray  # (N, J)
+    joint_vel: np.ndarray  # (N, J)
+    joint_acc: np.ndarray  # (N, J)
+    torque: np.ndarray  # (N, J) actuator torques
+    foot_pos: np.ndarray  # (N, 2, 3) sole sites, left then right
+    foot_vel: np.ndarray  # (N, 2, 3) world
+    foot_pitch: np.ndarray  # (N, 2)
+    foot_height: np.ndarray  # (N, 2) above the terrain under each sole
+    foot_force: np.ndarray  # (N, 2) max over substeps of |ground reaction|
+    foot_lateral_force: np.ndarray  # (N, 2) max over substeps of |F_xy|
+    leg_contact_force: np.ndarray  # (N, B) max over substeps, undesired leg bodies
+
+
+class ContactAccumulator:
+    """Tracks contact-force maxima over the substeps of one policy step."""
+
+    def __init__(self, sim: BatchedSim):
+        self.sim = sim
+        self.feet = [sim.sensor(f"{side}_foot_contact") for side in g1.FEET]
+        self.legs = [
+            sim.sensor(f"{side}_{part}_contact")
+            for side in g1.FEET
+            for part in g1.UNDESIRED_CONTACT_BODIES
+        ]
+        n = sim.num_envs
+        self.foot_force = np.zeros((n, 2))
+        self.foot_lateral = np.zeros((n, 2))
+        self.leg_force = np.zeros((n, len(self.legs)))
+
+    def clear(self) -> None:
+        self.foot_force[:] = 0
+        self.foot_lateral[:] = 0
+        self.leg_force[:] = 0
+
+    def update(self) -> None:
+        for i, sensor in enumerate(self.feet):
+            force = sensor[:, 1:4]
+            np.maximum(self.foot_force[:, i], np.linalg.norm(force, axis=1), self.foot_force[:, i])
+            lateral = np.linalg.norm(force[:, :2], axis=1)
+            np.maximum(self.foot_lateral[:, i], lateral, self.foot_lateral[:, i])
+        for i, sensor in enumerate(self.legs):
+            force = np.linalg.norm(sensor[:, 1:4], axis=1)
+            np.maximum(self.leg_force[:, i], force, self.leg_force[:, i])
+
+
+def read_state(sim: BatchedSim, contacts: ContactAccumulator) -> RobotState:
+    height_at = sim.scene.terrain.height_at
+    qpos, qvel = sim.qpos, sim.qvel
+    base_pos = qpos[:, :3].copy()
+    foot_pos = np.stack([sim.sensor(f"{s}_foot_pos") for s in g1.FEET], 1).copy()
+    foot_quat = np.stack([sim.sensor(f"{s}_foot_quat") for s in g1.FEET], 1)
+    return RobotState(
+        base_pos=base_pos,
+        base_quat=qpos[:, 3:7].copy(),
+        base_lin_vel=sim.sensor("imu_lin_vel").copy(),
+        base_ang_vel=sim.sensor("imu_ang_vel").copy(),
+        projected_gravity=-sim.sensor("imu_up"),
+        base_height=base_pos[:, 2] - height_at(base_pos[:, 0], base_pos[:, 1]),
+        joint_pos=qpos[:, 7:].copy(),
+        joint_vel=qvel[:, 6:].copy(),
+        joint_acc=sim.qacc[:, 6:].copy(),
+        torque=sim.actuator_force.copy(),
+        foot_pos=foot_pos,
+        foot_vel=np.stack([sim.sensor(f"{s}_foot_lin_vel") for s in g1.FEET], 1).copy(),
+        foot_pitch=pitch_of(foot_quat),
+        foot_height=foot_pos[..., 2] - height_at(foot_pos[..., 0], foot_pos[..., 1]),
+        foot_force=contacts.foot_force.copy(),
+        foot_lateral_force=contacts.foot_lateral.copy(),
+        leg_contact_force=contacts.leg_force.copy(),
+    )
