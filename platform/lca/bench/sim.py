@@ -9,7 +9,6 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import mujoco
-import numpy as np
 
 from lca.bench.timing import median_rate
 from lca.config import compose

@@ -121,10 +121,11 @@ class TerrainConfig:
     def check(self) -> None:
         weights = [getattr(self.mixture, t) for t in TERRAIN_TYPES]
         _require(min(weights) >= 0, "terrain.mixture", f"weights must be >= 0, got {weights}")
+        named = dict(zip(TERRAIN_TYPES, weights, strict=True))
         _require(
             abs(sum(weights) - 1.0) < 1e-6,
             "terrain.mixture",
-            f"weights must sum to 1, got {sum(weights):.6g} ({dict(zip(TERRAIN_TYPES, weights))})",
+            f"weights must sum to 1, got {sum(weights):.6g} ({named})",
         )
         _require(self.rows >= 1 and self.cols >= 1, "terrain.rows/cols", "must be >= 1")
         _require(self.resolution > 0, "terrain.resolution", "must be > 0")
