@@ -7,7 +7,7 @@ import importlib
 import json
 import sys
 
-BENCHMARKS = ("sim",)
+BENCHMARKS = ("sim", "env")
 
 
 def main(argv: list[str] | None = None) -> int:

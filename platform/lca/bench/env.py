@@ -1,0 +1,94 @@
+"""Full environment policy steps per second against raw batched physics of the same model.
+
+Each row builds one `LocomotionEnv` (observations, rewards, height grids, resets) and times
+its `step` with random actions, then times `sim.step(nstep=decimation)` on the very same
+batch: ratio = env / raw, both in policy steps per second.
+"""
+
+from __future__ import annotations
+
+import resource
+from collections.abc import Callable
+
+import torch
+
+from lca.bench.timing import median_rate
+from lca.config import compose
+from lca.sim.scene import build_scene
+from lca.task.env import LocomotionEnv
+
+NUM_ENVS = (64, 256, 1024)
+THREADS = (1, 2)
+REPEATS = 3
+MIN_SECONDS = 1.5
+
+
+def _max_rss_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def measure(cfg, scene, num_envs: int, threads: int) -> dict:
+    cfg.task.num_envs = num_envs
+    cfg.sim.num_threads = threads
+    torch.manual_seed(0)
+    rss_before = _max_rss_mb()
+    env = LocomotionEnv(cfg, scene=scene)
+    rss_after = _max_rss_mb()
+    actions = 0.3 * torch.randn(num_envs, env.num_actions)
+
+    def env_chunk() -> int:
+        env.step(actions)
+        return num_envs
+
+    def raw_chunk() -> int:
+        env.sim.step(nstep=env.decimation)
+        return num_envs
+
+    env_rate = median_rate(env_chunk, REPEATS, MIN_SECONDS)
+    env.sim.reset()
+    raw_rate = median_rate(raw_chunk, REPEATS, MIN_SECONDS)
+    return {
+        "num_envs": num_envs,
+        "threads": threads,
+        "steps_per_s": env_rate,
+        "raw_steps_per_s": raw_rate,
+        "ratio": env_rate / raw_rate,
+        "rss_growth_mb_per_env": max(rss_after - rss_before, 0.0) / num_envs,
+    }
+
+
+def run(overrides: list[str], log: Callable[[str], None] | None = print) -> dict:
+    cfg = compose(overrides)
+    scene = build_scene(cfg)
+    rows = []
+    for num_envs in NUM_ENVS:
+        for threads in THREADS:
+            row = measure(cfg, scene, num_envs, threads)
+            rows.append(row)
+            if log:
+                log(
+                    f"N={num_envs:5d} threads={threads}: env {row['steps_per_s']:,.0f} /s, "
+                    f"raw {row['raw_steps_per_s']:,.0f} /s, ratio {row['ratio']:.2f}"
+                )
+    return {
+        "policy_steps": "per second, all envs",
+        "max_rss_mb": _max_rss_mb(),
+        "batched": rows,
+    }
+
+
+def table(result: dict) -> str:
+    lines = [
+        f"{'num_envs':>8} {'threads':>7} {'env/s':>10} {'raw/s':>10} {'ratio':>6} {'MB/env':>7}"
+    ]
+    for r in result["batched"]:
+        lines.append(
+            f"{r['num_envs']:>8} {r['threads']:>7} {r['steps_per_s']:>10,.0f} "
+            f"{r['raw_steps_per_s']:>10,.0f} {r['ratio']:>6.2f} {r['rss_growth_mb_per_env']:>7.3f}"
+        )
+    lines.append(f"peak RSS {result['max_rss_mb']:,.0f} MB")
+    hit = [r for r in result["batched"] if r["num_envs"] == 256 and r["threads"] == 2]
+    if hit:
+        verdict = "meets" if hit[0]["ratio"] >= 0.8 else "MISSES"
+        lines.append(f"target: N=256, 2 threads ratio >= 0.8: {hit[0]['ratio']:.2f} ({verdict})")
+    return "\n".join(lines)
