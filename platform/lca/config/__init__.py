@@ -1,6 +1,17 @@
 """Structured Hydra configs: schema dataclasses, validation and composition."""
 
 from lca.config.compose import ConfigError, compose, conf_dir, validate
+from lca.config.runtime import register_resolvers, resolve_device, set_torch_threads
 from lca.config.schema import LcaConfig
 
-__all__ = ["ConfigError", "LcaConfig", "compose", "conf_dir", "validate"]
+register_resolvers()
+
+__all__ = [
+    "ConfigError",
+    "LcaConfig",
+    "compose",
+    "conf_dir",
+    "resolve_device",
+    "set_torch_threads",
+    "validate",
+]

@@ -8,6 +8,7 @@ from pathlib import Path
 from hydra import compose as hydra_compose
 from hydra import initialize_config_dir
 from omegaconf import DictConfig, OmegaConf
+from omegaconf.errors import ConfigKeyError, ValidationError
 
 from lca.config import schema
 from lca.config.schema import ConfigValueError
@@ -23,8 +24,21 @@ def conf_dir() -> Path:
     return Path(__file__).resolve().parents[3] / "conf"
 
 
+def _reject_unknown_keys(cfg: DictConfig) -> None:
+    """A `+key=value` append slips past Hydra's struct check; the schema must still hold."""
+    plain = OmegaConf.to_container(cfg, resolve=False)
+    plain.pop("hydra", None)
+    try:
+        OmegaConf.merge(OmegaConf.structured(schema.LcaConfig), plain)
+    except (ConfigKeyError, ValidationError) as err:
+        key = getattr(err, "full_key", None) or "config"
+        raise ConfigError(f"{key}: not in the schema ({err.msg.splitlines()[0]})") from None
+
+
 def validate(cfg: DictConfig) -> None:
-    """Run every group's `check()`; raises ConfigError naming the bad key."""
+    """Check keys against the schema, then run every group's `check()`; raises ConfigError
+    naming the bad key."""
+    _reject_unknown_keys(cfg)
     obj = OmegaConf.to_object(cfg)
     for group in vars(obj).values():
         check = getattr(group, "check", None)

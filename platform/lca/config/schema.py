@@ -256,12 +256,21 @@ class TaskConfig:
             )
 
 
+ACTOR_KINDS = ("mlp", "lstm")
+ENCODER_KINDS = ("cnn", "mlp")
+
+
 @dataclass
 class ActorConfig:
     name: str = "mlp"
     kind: str = "mlp"  # mlp | lstm
     hidden_dims: list[int] = field(default_factory=lambda: [512, 256, 128])
     activation: str = "elu"
+    rnn_hidden_dim: int = 256  # LSTM width before the MLP head (lstm only)
+    init_noise_std: float = 1.0
+
+    def check(self) -> None:
+        _require(self.kind in ACTOR_KINDS, "actor.kind", f"unknown '{self.kind}'; allowed: {ACTOR_KINDS}")
 
 
 @dataclass
@@ -269,8 +278,17 @@ class EncoderConfig:
     name: str = "cnn"
     kind: str = "cnn"  # cnn | mlp
     hidden_dims: list[int] = field(default_factory=lambda: [256, 256])
+    latent_dim: int = 32  # z_H
+    conv_channels: list[int] = field(default_factory=lambda: [16, 16])  # cnn only
     kernel_size: int = 3
     stride: int = 1
+
+    def check(self) -> None:
+        _require(
+            self.kind in ENCODER_KINDS,
+            "encoder.kind",
+            f"unknown '{self.kind}'; allowed: {ENCODER_KINDS}",
+        )
 
 
 @dataclass
@@ -278,11 +296,28 @@ class CurriculumConfig:
     name: str = "two"
     perception_from: float = 0.5  # fraction of iterations after which the actor sees its map
 
+    def check(self) -> None:
+        _require(
+            0.0 <= self.perception_from <= 1.0, "curriculum.perception_from", "must be in [0, 1]"
+        )
+
 
 @dataclass
 class AlgoConfig:
     name: str = "ppo"
-    params: dict[str, Any] = field(default_factory=dict)
+    num_steps_per_env: int = 24
+    num_learning_epochs: int = 5
+    num_mini_batches: int = 4
+    clip_param: float = 0.2
+    gamma: float = 0.99
+    lam: float = 0.95
+    value_loss_coef: float = 1.0
+    entropy_coef: float = 0.005
+    learning_rate: float = 1.0e-3
+    max_grad_norm: float = 1.0
+    schedule: str = "adaptive"
+    desired_kl: float = 0.01
+    obs_normalization: bool = True
 
 
 @dataclass
@@ -293,7 +328,13 @@ class EvalConfig:
 
 @dataclass
 class LoggerConfig:
-    name: str = "tensorboard"
+    name: str = "tensorboard"  # tensorboard | wandb | none
+    wandb_project: str = "lca"
+    wandb_mode: str = "offline"  # used unless WANDB_MODE is set in the environment
+
+    def check(self) -> None:
+        allowed = ("tensorboard", "wandb", "none")
+        _require(self.name in allowed, "logger.name", f"unknown '{self.name}'; allowed: {allowed}")
 
 
 @dataclass
@@ -301,13 +342,17 @@ class ScaleConfig:
     name: str = "cpu"
     num_envs: int = 256
     max_iterations: int = 100
+    log_interval: int = 5  # iterations between progress lines
+    checkpoint_interval: int = 25  # iterations between resumable checkpoints
 
 
 @dataclass
 class LcaConfig:
     seed: int = 0
-    device: str = "cpu"  # torch device; "cuda" when a GPU exists
+    device: str = "auto"  # torch device: auto = cuda when available, else cpu
     torch_threads: int = 0  # 0 = torch default
+    runs_root: str = "runs"  # run store: one folder per run, named by its overrides
+    force: bool = False  # re-run even when the run directory holds a completed run
     sim: SimConfig = field(default_factory=SimConfig)
     robot: RobotConfig = field(default_factory=RobotConfig)
     terrain: TerrainConfig = field(default_factory=TerrainConfig)

@@ -3,7 +3,8 @@ heightfield array, with an exact vectorised height query.
 
 Stairs are square pyramids around the tile centre. `stairs_up` is a pit: the robot spawns on
 the bottom platform and climbs outwards in any direction; `stairs_down` is a hill it descends.
-Every tile's outer ring is at height 0, so neighbouring tiles meet without a cliff.
+Stairs tiles' outer ring is at height 0, so they meet flat neighbours without a cliff;
+uneven tiles run their blocks to the tile edge.
 Risers are drawn once per tile (a real flight has equal risers), uniformly in the difficulty's
 range; the tread is the difficulty's depth.
 """
@@ -100,8 +101,9 @@ def _blocks(lx, ly, cfg, low, high, rng) -> np.ndarray:
     half = cfg.tile_size / 2
     nb = int(round(cfg.tile_size / cfg.block_size))
     block_heights = rng.uniform(low, high, size=(nb, nb))
-    bi = np.clip(((ly + half) / cfg.block_size).astype(int), 0, nb - 1)
-    bj = np.clip(((lx + half) / cfg.block_size).astype(int), 0, nb - 1)
+    # The epsilon keeps samples exactly on a block edge (k * block_size) in block k.
+    bi = np.clip(np.floor((ly + half) / cfg.block_size + 1e-9).astype(int), 0, nb - 1)
+    bj = np.clip(np.floor((lx + half) / cfg.block_size + 1e-9).astype(int), 0, nb - 1)
     h = block_heights[bi, bj]
     on_platform = np.maximum(np.abs(lx), np.abs(ly)) <= cfg.platform / 2
     return np.where(on_platform, (low + high) / 2, h)

@@ -16,6 +16,7 @@ from omegaconf import DictConfig
 from rsl_rl.env import VecEnv
 from tensordict import TensorDict
 
+from lca.config.runtime import resolve_device
 from lca.sim.batch import BatchedSim
 from lca.sim.scene import Scene, build_scene
 from lca.task import heightmap, observations
@@ -43,7 +44,7 @@ class LocomotionEnv(VecEnv):
         self.cfg = cfg
         task = cfg.task
         self.task_cfg = task
-        self.device = torch.device(cfg.device)
+        self.device = torch.device(resolve_device(cfg.device))
         self.num_envs = int(task.num_envs)
         self.scene = scene if scene is not None else build_scene(cfg)
         self.sim = BatchedSim(self.scene, self.num_envs, cfg.sim.num_threads, seed=cfg.seed)

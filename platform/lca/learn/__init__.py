@@ -1,0 +1,1 @@
+"""Learning layer: actor/critic models, curricula, and the training loop around rsl-rl PPO."""
