@@ -1,15 +1,28 @@
-"""Entry point: `python run.py [overrides]` composes one run; `-m` sweeps a grid."""
+"""Entry point: `python run.py [overrides]` trains one run; `-m` sweeps a grid.
+
+python run.py -m actor=mlp,lstm curriculum=one,two
+"""
+
+from pathlib import Path
 
 import hydra
-from omegaconf import DictConfig, OmegaConf
+from hydra.core.hydra_config import HydraConfig
+from omegaconf import DictConfig
 
-import lca.config  # noqa: F401  registers the structured schema
+import lca.config
+from lca.learn.run import run_training
 
 
 @hydra.main(config_path="conf", config_name="config", version_base="1.3")
-def main(cfg: DictConfig) -> None:
+def main(cfg: DictConfig) -> dict | None:
     lca.config.validate(cfg)
-    print(OmegaConf.to_yaml(cfg))
+    hydra_cfg = HydraConfig.get()
+    return run_training(
+        cfg,
+        Path(hydra_cfg.runtime.output_dir),
+        list(hydra_cfg.overrides.task),
+        dict(hydra_cfg.runtime.choices),
+    )
 
 
 if __name__ == "__main__":

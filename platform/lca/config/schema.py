@@ -270,7 +270,9 @@ class ActorConfig:
     init_noise_std: float = 1.0
 
     def check(self) -> None:
-        _require(self.kind in ACTOR_KINDS, "actor.kind", f"unknown '{self.kind}'; allowed: {ACTOR_KINDS}")
+        _require(
+            self.kind in ACTOR_KINDS, "actor.kind", f"unknown '{self.kind}'; allowed: {ACTOR_KINDS}"
+        )
 
 
 @dataclass

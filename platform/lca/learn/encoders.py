@@ -4,9 +4,8 @@ same module serves (B, ...) rollouts and (T, B, ...) recurrent updates."""
 from __future__ import annotations
 
 import torch
-from torch import nn
-
 from rsl_rl.utils import resolve_nn_activation
+from torch import nn
 
 
 def _mlp(in_dim: int, hidden: list[int], out_dim: int, activation: str) -> list[nn.Module]:
@@ -35,7 +34,7 @@ class HeightmapEncoder(nn.Module):
     ):
         super().__init__()
         self.kind = kind
-        self.shape = tuple(shape)
+        self.shape = [int(d) for d in shape]
         self.latent_dim = latent_dim
         channels, height, width = self.shape
         layers: list[nn.Module] = []
@@ -55,6 +54,6 @@ class HeightmapEncoder(nn.Module):
         self.net = nn.Sequential(*layers)
 
     def forward(self, image: torch.Tensor) -> torch.Tensor:
-        lead = image.shape[:-3]
-        z = self.net(image.reshape(-1, *self.shape))
-        return z.reshape(*lead, self.latent_dim)
+        lead = list(image.shape[:-3])
+        z = self.net(image.reshape([-1] + self.shape))
+        return z.reshape(lead + [self.latent_dim])

@@ -12,12 +12,12 @@ from __future__ import annotations
 import copy
 
 import torch
+from rsl_rl.models import MLPModel
+from rsl_rl.modules import RNN, HiddenState
 from tensordict import TensorDict
 from torch import nn
 
 from lca.learn.encoders import HeightmapEncoder
-from rsl_rl.models import MLPModel
-from rsl_rl.modules import RNN, HiddenState
 
 
 class PerceptiveMLPModel(MLPModel):
@@ -49,16 +49,20 @@ class PerceptiveMLPModel(MLPModel):
             obs_normalization,
             distribution_cfg,
         )
-        self.encoder = HeightmapEncoder(shape=self.image_shape, activation=activation, **encoder_cfg)
+        self.encoder = HeightmapEncoder(
+            shape=self.image_shape, activation=activation, **encoder_cfg
+        )
 
-    def _get_obs_dim(self, obs: TensorDict, obs_groups: dict, obs_set: str) -> tuple[list[str], int]:
+    def _get_obs_dim(
+        self, obs: TensorDict, obs_groups: dict, obs_set: str
+    ) -> tuple[list[str], int]:
         flat, images = [], []
         for group in obs_groups[obs_set]:
             (images if obs[group].dim() == 4 else flat).append(group)
         if len(images) != 1:
             raise ValueError(f"{obs_set}: expected exactly one image group, got {images}")
         self.image_group = images[0]
-        self.image_shape = tuple(obs[self.image_group].shape[1:])
+        self.image_shape = [int(d) for d in obs[self.image_group].shape[1:]]
         return flat, sum(obs[g].shape[-1] for g in flat)
 
     def _get_latent_dim(self) -> int:

@@ -36,7 +36,10 @@ def git_state(repo: Path) -> dict:
         return out.stdout.strip()
 
     commit = git("rev-parse", "HEAD")
-    return {"commit": commit or None, "dirty": bool(git("status", "--porcelain")) if commit else None}
+    return {
+        "commit": commit or None,
+        "dirty": bool(git("status", "--porcelain")) if commit else None,
+    }
 
 
 def versions() -> dict:
