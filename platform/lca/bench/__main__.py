@@ -7,7 +7,7 @@ import importlib
 import json
 import sys
 
-BENCHMARKS = ("sim", "env")
+BENCHMARKS = ("sim", "env", "train")
 
 
 def main(argv: list[str] | None = None) -> int:

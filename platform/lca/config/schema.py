@@ -284,6 +284,7 @@ class EncoderConfig:
     conv_channels: list[int] = field(default_factory=lambda: [16, 16])  # cnn only
     kernel_size: int = 3
     stride: int = 1
+    pool: int = 2  # max-pool after each convolution (cnn only); 0 disables
 
     def check(self) -> None:
         _require(

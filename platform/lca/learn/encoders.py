@@ -18,8 +18,9 @@ def _mlp(in_dim: int, hidden: list[int], out_dim: int, activation: str) -> list[
 
 
 class HeightmapEncoder(nn.Module):
-    """`kind="cnn"`: 3x3 stride-1 convolutions then an MLP head; `kind="mlp"`: an MLP over
-    the flattened map. Both use `hidden_dims` for the head (paper: {256, 256})."""
+    """`kind="cnn"`: 3x3 stride-1 convolutions (each optionally followed by max-pooling),
+    then an MLP head; `kind="mlp"`: an MLP over the flattened map. Both use `hidden_dims` for
+    the head (paper: {256, 256})."""
 
     def __init__(
         self,
@@ -30,6 +31,7 @@ class HeightmapEncoder(nn.Module):
         conv_channels: list[int],
         kernel_size: int = 3,
         stride: int = 1,
+        pool: int = 0,
         activation: str = "elu",
     ):
         super().__init__()
@@ -47,6 +49,9 @@ class HeightmapEncoder(nn.Module):
                 channels = out
                 height = (height + 2 * (kernel_size // 2) - kernel_size) // stride + 1
                 width = (width + 2 * (kernel_size // 2) - kernel_size) // stride + 1
+                if pool > 1:
+                    layers.append(nn.MaxPool2d(pool))
+                    height, width = height // pool, width // pool
         elif kind != "mlp":
             raise ValueError(f"encoder.kind: unknown '{kind}'; allowed: cnn, mlp")
         layers.append(nn.Flatten())

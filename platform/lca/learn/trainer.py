@@ -89,6 +89,7 @@ class Trainer:
     def __init__(self, cfg: DictConfig, run_dir: RunDir, env: LocomotionEnv | None = None):
         self.cfg = cfg
         self.run = run_dir
+        run_dir.path.mkdir(parents=True, exist_ok=True)
         self.device = resolve_device(cfg.device)
         self.total = int(cfg.scale.max_iterations)
         torch.manual_seed(int(cfg.seed))
