@@ -7,7 +7,7 @@ import importlib
 import json
 import sys
 
-BENCHMARKS = ("sim", "env", "train")
+BENCHMARKS = ("sim", "env", "train", "learn")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -20,9 +20,7 @@ ITERATIONS = 6
 
 def run(overrides: list[str], log: Callable[[str], None] | None = print) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
-        cfg = compose(
-            ["logger=none", f"scale.max_iterations={WARMUP + ITERATIONS}", *overrides]
-        )
+        cfg = compose(["logger=none", f"scale.max_iterations={WARMUP + ITERATIONS}", *overrides])
         cfg.scale.log_interval = 10**9
         set_torch_threads(int(cfg.torch_threads))
         trainer = Trainer(cfg, RunDir(Path(tmp) / "bench"))
@@ -60,6 +58,7 @@ def table(r: dict) -> str:
             f"iteration {r['iteration_s']:.2f} s = collect {r['collect_s']:.2f} s + "
             f"update {r['update_s']:.2f} s",
             f"steps/s {r['steps_per_s']:,.0f} (collection alone {r['collect_steps_per_s']:,.0f})",
-            f"target: update <= 25 % of an iteration: {100 * r['update_fraction']:.1f} % ({verdict})",
+            f"target: update <= 25 % of an iteration: "
+            f"{100 * r['update_fraction']:.1f} % ({verdict})",
         ]
     )
