@@ -10,14 +10,14 @@ from hydra.core.hydra_config import HydraConfig
 from omegaconf import DictConfig
 
 import lca.config
-from lca.learn.run import run_training
+from lca.pipeline import run_pipeline
 
 
 @hydra.main(config_path="conf", config_name="config", version_base="1.3")
 def main(cfg: DictConfig) -> dict | None:
     lca.config.validate(cfg)
     hydra_cfg = HydraConfig.get()
-    return run_training(
+    return run_pipeline(
         cfg,
         Path(hydra_cfg.runtime.output_dir),
         list(hydra_cfg.overrides.task),

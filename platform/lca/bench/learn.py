@@ -16,7 +16,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from lca.config import compose  # noqa: E402
-from lca.learn.run import run_training  # noqa: E402
+from lca.learn.run import train_run  # noqa: E402
+from lca.learn.rundir import RunDir  # noqa: E402
 
 BASE = ["terrain=flat", "curriculum=blind", "actor=mlp", "encoder=mlp", "logger=none"]
 REPORTS = Path(__file__).resolve().parents[3] / "reports"
@@ -52,8 +53,11 @@ def plot(curve: pd.DataFrame, out: Path) -> None:
 def run(overrides: list[str], log: Callable[[str], None] | None = print) -> dict:
     cfg = compose([*BASE, *overrides])
     run_path = Path(cfg.runs_root) / "learning_evidence"
-    cfg.force = True
-    run_training(cfg, run_path, [*BASE, *overrides], {})
+    if (run_path / "checkpoints").exists():
+        import shutil
+
+        shutil.rmtree(run_path)
+    train_run(cfg, RunDir(run_path))
     curve = pd.read_csv(run_path / "train_curve.csv")
     REPORTS.mkdir(exist_ok=True)
     plot(curve, REPORTS / "learning_evidence.png")

@@ -7,7 +7,6 @@ in `check()` methods that `lca.config.validate` runs right after composition.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
 
 from hydra.core.config_store import ConfigStore
 from omegaconf import MISSING
@@ -323,10 +322,47 @@ class AlgoConfig:
     obs_normalization: bool = True
 
 
+EVAL_TERRAINS = ("stairs", "uneven", "flat", "stairs_up", "stairs_down", "mixed")
+DIFFICULTIES = ("medium", "hard")
+
+
+@dataclass
+class EvalCell:
+    terrain: str = MISSING  # stairs (= half up, half down) | uneven | flat | stairs_up | ...
+    difficulty: str = MISSING  # medium | hard
+
+
 @dataclass
 class EvalConfig:
     name: str = "default"
-    params: dict[str, Any] = field(default_factory=dict)
+    units: int = 32  # simulated robots per cell (paper: 500)
+    episodes: int = 2  # episodes per unit (paper: 3)
+    steps: int = 500  # policy steps per episode (paper: 1000)
+    cells: list[EvalCell] = field(
+        default_factory=lambda: [
+            EvalCell(t, d) for t in ("stairs", "uneven") for d in ("medium", "hard")
+        ]
+    )
+    command_x: list[float] = field(default_factory=lambda: [0.3, 0.6])  # m/s forward
+    seed: int = 12345
+    bootstrap_resamples: int = 2000
+    confidence: float = 0.95
+
+    def check(self) -> None:
+        for key in ("units", "episodes", "steps"):
+            _require(getattr(self, key) >= 1, f"eval.{key}", "must be >= 1")
+        for i, cell in enumerate(self.cells):
+            _require(
+                cell.terrain in EVAL_TERRAINS,
+                f"eval.cells[{i}].terrain",
+                f"unknown '{cell.terrain}'; allowed: {EVAL_TERRAINS}",
+            )
+            _require(
+                cell.difficulty in DIFFICULTIES,
+                f"eval.cells[{i}].difficulty",
+                f"unknown '{cell.difficulty}'; allowed: {DIFFICULTIES}",
+            )
+        _check_range("eval.command_x", self.command_x, -1e9)
 
 
 @dataclass

@@ -132,7 +132,11 @@ class LocomotionEnv(VecEnv):
             self.episode_sums[name] += value
 
         done = terminated | time_out
-        extras = {"time_outs": torch.as_tensor(time_out, device=self.device), "log": {}}
+        extras = {
+            "time_outs": torch.as_tensor(time_out, device=self.device),
+            "log": {},
+            "metrics": self._step_metrics(state, terminated, time_out),
+        }
         done_ids = np.flatnonzero(done)
         if done_ids.size:
             extras["log"] = self._episode_log(done_ids, fallen, time_out)
@@ -168,7 +172,6 @@ class LocomotionEnv(VecEnv):
         for sums in self.episode_sums.values():
             sums[ids] = 0.0
         self.contacts.clear()
-        self._fresh = ids
 
     def _maybe_push(self) -> None:
         if self._push_steps <= 0:
@@ -262,6 +265,31 @@ class LocomotionEnv(VecEnv):
             batch_size=[n],
             device=self.device,
         )
+
+    def _step_metrics(self, state: RobotState, terminated: np.ndarray, time_out: np.ndarray):
+        """Per-env numpy quantities of this step, before any reset, for evaluation."""
+        threshold = self.task_cfg.reward_params.strike_threshold
+        error = self.commands.value[:, :2] - state.base_lin_vel[:, :2]
+        return {
+            "terminated": terminated.copy(),
+            "time_out": time_out.copy(),
+            "lateral_impact": (state.foot_lateral_force > threshold).any(axis=1),
+            "track_error": np.linalg.norm(error, axis=1),
+        }
+
+    def reseed(self, seed: int) -> None:
+        """Restart every random stream (resets, noise, commands) from `seed`."""
+        self.rng = np.random.default_rng(seed)
+        self.commands.rng = self.rng
+        self.sim.rng = np.random.default_rng(seed + 1)
+
+    def reset_all(self) -> TensorDict:
+        """Reset every environment and return fresh observations."""
+        self._reset_envs(np.arange(self.num_envs))
+        self.history.buffer[:] = 0.0
+        self.critic_history.buffer[:] = 0.0
+        self._obs = self._observe(read_state(self.sim, self.contacts))
+        return self._obs
 
     def set_perception(self, on: bool) -> None:
         """Curriculum switch: when off the actor's map is exactly zero; the critic keeps its map."""

@@ -1,0 +1,1 @@
+"""Evaluation layer: the paper's protocol, its metrics and statistics."""

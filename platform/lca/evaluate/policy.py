@@ -1,0 +1,46 @@
+"""Load a run's config and final policy from its run directory."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+from pathlib import Path
+
+import torch
+from omegaconf import DictConfig, OmegaConf
+from rsl_rl.runners import OnPolicyRunner
+
+from lca.config import schema, validate
+from lca.config.runtime import resolve_device
+from lca.learn.train_cfg import build_train_cfg
+from lca.task.env import LocomotionEnv
+
+
+def load_run_config(run_dir: Path, overrides: list[str] | None = None) -> DictConfig:
+    """The run's resolved config.yaml, checked against the schema, plus dotlist overrides."""
+    path = Path(run_dir) / "config.yaml"
+    if not path.exists():
+        raise FileNotFoundError(f"run_dir: {run_dir} has no config.yaml (not a run directory)")
+    cfg = OmegaConf.merge(OmegaConf.structured(schema.LcaConfig), OmegaConf.load(path))
+    if overrides:
+        cfg = OmegaConf.merge(cfg, OmegaConf.from_dotlist(list(overrides)))
+    validate(cfg)
+    return cfg
+
+
+def final_checkpoint(run_dir: Path) -> Path:
+    finals = sorted((Path(run_dir) / "checkpoints").glob("final_*.pt"))
+    if not finals:
+        raise FileNotFoundError(f"run_dir: {run_dir} has no checkpoints/final_*.pt; train it first")
+    return finals[-1]
+
+
+def load_policy(cfg: DictConfig, env: LocomotionEnv, checkpoint: Path):
+    """The deterministic actor of `checkpoint`: `policy(obs)`, `policy.reset(dones)`."""
+    device = resolve_device(cfg.device)
+    with contextlib.redirect_stdout(io.StringIO()):
+        runner = OnPolicyRunner(env, build_train_cfg(cfg, "eval"), log_dir=None, device=device)
+    runner.load(str(checkpoint), load_cfg={"actor": True}, strict=True, map_location=device)
+    policy = runner.get_inference_policy(device)
+    torch.set_grad_enabled(False)
+    return policy

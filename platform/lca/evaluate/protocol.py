@@ -1,0 +1,141 @@
+"""The paper's evaluation protocol on one run: U units x E episodes x T steps per cell.
+
+Every (cell, episode round) is seeded from the eval seed alone, so all policies meet the same
+spawns, commands and noise (common random numbers: paired comparisons across policies).
+Each finished round is written to its own file; an interrupted evaluation resumes at the
+first missing round and never counts a round twice.
+"""
+
+from __future__ import annotations
+
+import copy
+import time
+import zlib
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import torch
+from omegaconf import DictConfig, OmegaConf
+
+from lca.config import conf_dir, schema
+from lca.evaluate.metrics import episode_metrics
+from lca.evaluate.policy import final_checkpoint, load_policy
+from lca.learn import curriculum
+from lca.learn.rundir import atomic_write
+from lca.task.env import LocomotionEnv
+
+CELL_MIXTURES = {
+    "stairs": {"stairs_up": 0.5, "stairs_down": 0.5},
+    "uneven": {"uneven": 1.0},
+    "flat": {"flat": 1.0},
+    "stairs_up": {"stairs_up": 1.0},
+    "stairs_down": {"stairs_down": 1.0},
+    "mixed": {"flat": 0.25, "stairs_up": 0.25, "stairs_down": 0.25, "uneven": 0.25},
+}
+
+
+def cell_name(cell) -> str:
+    return f"{cell.terrain}-{cell.difficulty}"
+
+
+def round_seed(base: int, cell, episode: int) -> int:
+    return (base * 1_000_003 + zlib.crc32(cell_name(cell).encode()) + episode) % 2**31
+
+
+def difficulty_config(name: str) -> DictConfig:
+    """A difficulty group option, read from conf/ (works inside a running Hydra app too)."""
+    loaded = OmegaConf.load(conf_dir() / "difficulty" / f"{name}.yaml")
+    return OmegaConf.merge(OmegaConf.structured(schema.DifficultyConfig), loaded)
+
+
+def cell_config(cfg: DictConfig, cell) -> DictConfig:
+    """The run's config turned into the evaluation setting of one cell."""
+    c = copy.deepcopy(cfg)
+    ev = cfg.eval
+    mixture = {t: 0.0 for t in schema.TERRAIN_TYPES} | CELL_MIXTURES[cell.terrain]
+    for kind, weight in mixture.items():
+        setattr(c.terrain.mixture, kind, weight)
+    c.terrain.name = cell.terrain
+    c.difficulty = difficulty_config(cell.difficulty)
+    c.task.num_envs = ev.units
+    c.task.episode_length_s = ev.steps * cfg.sim.timestep * cfg.sim.decimation
+    c.task.randomization.enabled = False  # nominal friction and mass, no pushes
+    c.task.commands.lin_vel_x = list(ev.command_x)
+    c.task.commands.lin_vel_y = [0.0, 0.0]
+    c.task.commands.ang_vel_z = [0.0, 0.0]
+    c.task.commands.standing_fraction = 0.0
+    c.task.commands.resample_time_s = 2 * c.task.episode_length_s
+    return c
+
+
+def run_round(env: LocomotionEnv, policy, steps: int) -> dict[str, np.ndarray]:
+    """One episode for every unit; a unit stops counting at its first termination."""
+    n = env.num_envs
+    obs = env.reset_all()
+    policy.reset(torch.ones(n, dtype=torch.bool, device=env.device))
+    alive = np.ones(n, dtype=bool)
+    success = np.zeros(n, dtype=bool)
+    alive_steps = np.zeros(n)
+    impacts = np.zeros(n)
+    track = np.zeros(n)
+    command_x = env.commands.value[:, 0].copy()
+    for _ in range(steps):
+        obs, _, dones, extras = env.step(policy(obs))
+        m = extras["metrics"]
+        alive_steps += alive
+        impacts += alive & m["lateral_impact"]
+        track += np.where(alive, m["track_error"], 0.0)
+        success |= alive & m["time_out"]
+        alive &= ~(m["terminated"] | m["time_out"])
+        policy.reset(dones.bool())
+        if not alive.any():
+            break
+    out = episode_metrics(alive_steps, impacts, track, success)
+    out["command_x"] = command_x
+    return out
+
+
+def evaluate_run(run_dir: Path, cfg: DictConfig, log=print) -> pd.DataFrame:
+    """Run every missing (cell, episode) round, then return all episodes of the run."""
+    run_dir = Path(run_dir)
+    ev = cfg.eval
+    checkpoint = final_checkpoint(run_dir)
+    total = int(cfg.scale.max_iterations)
+    perception = curriculum.perception_on(cfg.curriculum, total - 1, total)
+    out_dir = run_dir / "eval"
+    for cell in ev.cells:
+        name = cell_name(cell)
+        todo = [e for e in range(ev.episodes) if not (out_dir / name / f"episode_{e}.csv").exists()]
+        if not todo:
+            continue
+        env = LocomotionEnv(cell_config(cfg, cell))
+        env.set_perception(perception)
+        policy = load_policy(cfg, env, checkpoint)
+        for episode in todo:
+            t0 = time.perf_counter()
+            env.reseed(round_seed(ev.seed, cell, episode))
+            result = run_round(env, policy, ev.steps)
+            frame = pd.DataFrame(result)
+            frame.insert(0, "unit", np.arange(ev.units))
+            frame.insert(1, "episode", episode)
+            atomic_write(out_dir / name / f"episode_{episode}.csv", frame.to_csv(index=False))
+            if log:
+                rate = ev.units * ev.steps / (time.perf_counter() - t0)
+                log(
+                    f"[lca] eval {run_dir.name} {name} episode {episode + 1}/{ev.episodes}: "
+                    f"success {frame['success'].mean():.1f} % ({rate:,.0f} steps/s)"
+                )
+    return collect_episodes(run_dir, cfg)
+
+
+def collect_episodes(run_dir: Path, cfg: DictConfig) -> pd.DataFrame:
+    frames = []
+    for cell in cfg.eval.cells:
+        for episode in range(cfg.eval.episodes):
+            path = Path(run_dir) / "eval" / cell_name(cell) / f"episode_{episode}.csv"
+            frame = pd.read_csv(path)
+            frame.insert(0, "cell_terrain", cell.terrain)
+            frame.insert(1, "cell_difficulty", cell.difficulty)
+            frames.append(frame)
+    return pd.concat(frames, ignore_index=True)

@@ -1,0 +1,1 @@
+"""Report layer: the paper's tables, figures and a static dashboard from run directories."""

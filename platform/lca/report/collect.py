@@ -1,0 +1,89 @@
+"""Find run directories and read what the earlier stages wrote into them."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+from omegaconf import OmegaConf
+
+ROW_ORDER = [
+    "Blind",
+    "One-Stage MLP",
+    "Two-Stage MLP",
+    "One-Stage LSTM",
+    "Two-Stage LSTM",
+    "One-Stage CNN",
+    "Two-Stage CNN",
+]
+STAGES = {"one": "One-Stage", "two": "Two-Stage"}
+
+
+def policy_label(curriculum: str, actor: str, encoder: str) -> str:
+    """The paper's row name, from the run's composed config (never from folder names).
+
+    MLP = MLP actor + MLP encoder, CNN = MLP actor + CNN encoder, LSTM = LSTM actor
+    (+ MLP encoder; with a CNN encoder it is reported as LSTM-CNN)."""
+    if curriculum == "blind":
+        return "Blind"
+    if actor == "lstm":
+        arch = "LSTM" if encoder == "mlp" else "LSTM-CNN"
+    else:
+        arch = "CNN" if encoder == "cnn" else "MLP"
+    return f"{STAGES.get(curriculum, curriculum)} {arch}"
+
+
+def row_key(label: str) -> tuple[int, str]:
+    return (ROW_ORDER.index(label) if label in ROW_ORDER else len(ROW_ORDER), label)
+
+
+@dataclass
+class RunRecord:
+    path: Path
+    label: str
+    curriculum: str
+    actor: str
+    encoder: str
+    seed: int
+    provenance: dict
+    episodes: pd.DataFrame | None
+    curve: pd.DataFrame | None
+
+    @property
+    def name(self) -> str:
+        return self.path.name
+
+
+def is_run_dir(path: Path) -> bool:
+    return (path / "config.yaml").exists() and (path / "provenance.json").exists()
+
+
+def find_run_dirs(paths: list[Path]) -> list[Path]:
+    """Run directories among `paths` and, for sweep folders, their direct subfolders."""
+    found = []
+    for path in map(Path, paths):
+        if is_run_dir(path):
+            found.append(path)
+        elif path.is_dir():
+            found += sorted(p for p in path.iterdir() if p.is_dir() and is_run_dir(p))
+    return found
+
+
+def load_run(path: Path) -> RunRecord:
+    cfg = OmegaConf.load(path / "config.yaml")
+    provenance = json.loads((path / "provenance.json").read_text())
+    results = path / "results.parquet"
+    curve = path / "train_curve.csv"
+    return RunRecord(
+        path=path,
+        label=policy_label(cfg.curriculum.name, cfg.actor.kind, cfg.encoder.kind),
+        curriculum=cfg.curriculum.name,
+        actor=cfg.actor.kind,
+        encoder=cfg.encoder.kind,
+        seed=int(cfg.seed),
+        provenance=provenance,
+        episodes=pd.read_parquet(results) if results.exists() else None,
+        curve=pd.read_csv(curve) if curve.exists() else None,
+    )

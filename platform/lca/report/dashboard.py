@@ -1,0 +1,100 @@
+"""A static HTML dashboard: tables, figures, the claim, and every run with its provenance."""
+
+from __future__ import annotations
+
+import html
+import os
+from pathlib import Path
+
+import pandas as pd
+from jinja2 import Template
+
+from lca.report.collect import RunRecord
+
+PAGE = Template(
+    """<!doctype html>
+<html lang="en"><head><meta charset="utf-8"><title>lca report</title>
+<style>
+ body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 1200px; color: #222; }
+ table { border-collapse: collapse; margin: 1em 0; font-size: 0.9em; }
+ th, td { border-bottom: 1px solid #ddd; padding: 4px 10px; text-align: center; }
+ td.best { font-weight: bold; }
+ img { max-width: 100%; }
+ code { background: #f4f4f4; padding: 1px 4px; }
+</style></head><body>
+<h1>lca: architecture ablations for humanoid locomotion</h1>
+<p>{{ n_runs }} run(s), {{ n_complete }} with evaluation results.</p>
+<h2 id="simulation">Simulation results</h2>
+<p>Mean ± standard error over units (all seeds pooled); best per column and difficulty in bold.
+Downloads: <a href="sim_table.tex">LaTeX</a>, <a href="sim_table.csv">CSV</a>.</p>
+{{ sim_table }}
+<h2 id="claim">Two-stage vs one-stage (paired)</h2>
+<p>Two-stage minus its one-stage twin (same actor, encoder and seed; units paired by common
+random numbers), 95 % paired bootstrap CI. <a href="claim.csv">CSV</a>.</p>
+{{ claim_table }}
+<h2 id="training">Training rewards</h2>
+<img src="training_rewards.png" alt="training rewards">
+<h2 id="runs">Runs</h2>
+{{ runs_table }}
+</body></html>
+"""
+)
+
+
+def runs_table(runs: list[RunRecord], out_dir: Path) -> str:
+    rows = []
+    for run in runs:
+        git = run.provenance.get("git", {})
+        rel = os.path.relpath(run.path, out_dir)
+        rows.append(
+            "<tr>"
+            f'<td><a href="{html.escape(rel)}/">{html.escape(run.name)}</a></td>'
+            f"<td>{html.escape(run.label)}</td><td>{run.seed}</td>"
+            f"<td><code>{html.escape(str(git.get('commit'))[:10])}</code>"
+            f"{' (dirty)' if git.get('dirty') else ''}</td>"
+            f'<td><a href="{html.escape(rel)}/config.yaml">config</a></td>'
+            f"<td>{'yes' if run.episodes is not None else 'no'}</td>"
+            "</tr>"
+        )
+    head = "<tr><th>run</th><th>policy</th><th>seed</th><th>commit</th><th>config</th>"
+    return f'<table id="runs-table">{head}<th>results</th></tr>{"".join(rows)}</table>'
+
+
+def latex_to_text(label: str) -> str:
+    for a, b in (
+        ("$R_{\\mathrm{succ}}$", "R_succ"),
+        ("\\%", "%"),
+        ("$\\uparrow$", "↑"),
+        ("$\\downarrow$", "↓"),
+    ):
+        label = label.replace(a, b)
+    return label
+
+
+def sim_table_html(text: pd.DataFrame, best: pd.DataFrame) -> str:
+    if text.empty:
+        return "<p>No evaluation results yet.</p>"
+    plain = text.map(lambda s: s.replace("$\\pm$", "±"))
+    plain.columns = pd.MultiIndex.from_tuples([(t, latex_to_text(m)) for t, m in plain.columns])
+    classes = best.replace({True: "best", False: ""})
+    classes.columns = plain.columns
+    styled = plain.style.set_td_classes(classes)
+    return styled.set_table_attributes('id="sim-table"').to_html()
+
+
+def write_dashboard(out_dir: Path, runs, text, best, claim: pd.DataFrame) -> Path:
+    claim_html = (
+        claim.round(3).to_html(index=False, table_id="claim-table")
+        if not claim.empty
+        else "<p>No two-stage / one-stage pair with results.</p>"
+    )
+    page = PAGE.render(
+        n_runs=len(runs),
+        n_complete=sum(r.episodes is not None for r in runs),
+        sim_table=sim_table_html(text, best),
+        claim_table=claim_html,
+        runs_table=runs_table(runs, out_dir),
+    )
+    path = out_dir / "index.html"
+    path.write_text(page)
+    return path

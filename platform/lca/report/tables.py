@@ -1,0 +1,149 @@
+"""The paper's simulation table (LaTeX + CSV) and the two-stage vs one-stage claim."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from lca.evaluate.metrics import METRICS, describe, paired_difference, unit_values
+from lca.report.collect import RunRecord, row_key
+
+TERRAINS = {"stairs": "Stairs", "uneven": "Uneven Terrain"}
+DIFFICULTIES = {"medium": "Medium difficulty", "hard": "Hard difficulty"}
+LOWER_IS_BETTER = {"contacts_per_step", "track_cm_s"}
+RESAMPLES, CONFIDENCE, SEED = 2000, 0.95, 0
+
+
+def pooled_episodes(runs: list[RunRecord]) -> pd.DataFrame:
+    """All episodes of runs with results; units made unique across seeds."""
+    frames = []
+    for run in runs:
+        if run.episodes is None:
+            continue
+        frame = run.episodes.copy()
+        frame["policy"] = run.label
+        frame["seed"] = run.seed
+        frame["unit"] = frame["unit"].astype(str).radd(f"{run.seed}:")
+        frames.append(frame)
+    return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
+
+
+def long_table(episodes: pd.DataFrame) -> pd.DataFrame:
+    """One row per policy x cell x metric: mean, se, CI over all units of all seeds."""
+    rows = []
+    keys = ["policy", "cell_terrain", "cell_difficulty"]
+    for (policy, terrain, difficulty), cell in episodes.groupby(keys, sort=False):
+        for metric in METRICS:
+            stats = describe(unit_values(cell, metric).to_numpy(), RESAMPLES, CONFIDENCE, SEED)
+            rows.append(
+                {
+                    "policy": policy,
+                    "terrain": terrain,
+                    "difficulty": difficulty,
+                    "metric": metric,
+                    "n_seeds": cell["seed"].nunique(),
+                    **stats,
+                }
+            )
+    table = pd.DataFrame(rows)
+    if table.empty:
+        return table
+    order = table["policy"].map(lambda p: row_key(p))
+    return table.assign(_o=order).sort_values(["_o", "difficulty", "terrain"]).drop(columns="_o")
+
+
+def _cell_text(mean: float, se: float, metric: str) -> str:
+    return f"{mean:.2f}" if metric == "success" else f"{mean:.2f} $\\pm$ {se:.2f}"
+
+
+def wide_table(table: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(display strings, numeric means), indexed (difficulty block, policy), columns
+    (terrain, metric label), in the paper's layout."""
+    diffs = [d for d in DIFFICULTIES if d in set(table["difficulty"])]
+    terrains = [t for t in TERRAINS if t in set(table["terrain"])]
+    policies = sorted(table["policy"].unique(), key=row_key)
+    index = pd.MultiIndex.from_product([[DIFFICULTIES[d] for d in diffs], policies])
+    columns = pd.MultiIndex.from_product([[TERRAINS[t] for t in terrains], list(METRICS.values())])
+    text = pd.DataFrame("--", index=index, columns=columns)
+    means = pd.DataFrame(np.nan, index=index, columns=columns)
+    for row in table.itertuples():
+        if row.terrain not in TERRAINS or row.difficulty not in DIFFICULTIES:
+            continue
+        key = (DIFFICULTIES[row.difficulty], row.policy)
+        col = (TERRAINS[row.terrain], METRICS[row.metric])
+        text.loc[key, col] = _cell_text(row.mean, row.se, row.metric)
+        means.loc[key, col] = row.mean
+    return text, means
+
+
+def best_mask(means: pd.DataFrame) -> pd.DataFrame:
+    """True where a cell is the best of its column within its difficulty block."""
+    mask = pd.DataFrame(False, index=means.index, columns=means.columns)
+    inverse = {v: k for k, v in METRICS.items()}
+    for block in means.index.get_level_values(0).unique():
+        part = means.loc[block]
+        for col in means.columns:
+            values = part[col]
+            if values.notna().sum() < 2:
+                continue
+            lower = inverse[col[1]] in LOWER_IS_BETTER
+            best = values.min() if lower else values.max()
+            for policy in values.index[np.isclose(values, best)]:
+                mask.loc[(block, policy), col] = True
+    return mask
+
+
+def to_latex(text: pd.DataFrame, best: pd.DataFrame) -> str:
+    """Booktabs LaTeX via pandas Styler; best cells bold."""
+    styled = text.style.apply(lambda col: np.where(best[col.name], "textbf:--rwrap;", ""), axis=0)
+    latex = styled.to_latex(
+        hrules=True,
+        multicol_align="c",
+        multirow_align="t",
+        clines="skip-last;index",
+        column_format="ll" + "c" * text.shape[1],
+        caption="Simulation results: success rate ($\\uparrow$), contacts per step "
+        "($\\downarrow$), tracking error ($\\downarrow$); mean $\\pm$ standard error over units.",
+        label="tab:sim_results",
+        position="t",
+    )
+    # booktabs rules between the difficulty blocks instead of Styler's \cline
+    cline = f"\\cline{{1-{text.index.nlevels}}}\n"
+    return latex.replace(cline + "\\bottomrule", "\\bottomrule").replace(cline, "\\midrule\n")
+
+
+def claim_table(runs: list[RunRecord]) -> pd.DataFrame:
+    """Two-stage minus its one-stage twin (same actor, encoder, seed), per cell, for success
+    and contacts/step: paired bootstrap CI over units (common random numbers)."""
+    by_key = {(r.curriculum, r.actor, r.encoder, r.seed): r for r in runs if r.episodes is not None}
+    rows = []
+    for (curr, actor, encoder, seed), two in sorted(by_key.items()):
+        one = by_key.get(("one", actor, encoder, seed))
+        if curr != "two" or one is None:
+            continue
+        keys = ["cell_terrain", "cell_difficulty"]
+        for (terrain, difficulty), cell_two in two.episodes.groupby(keys):
+            cell_one = one.episodes[
+                (one.episodes.cell_terrain == terrain)
+                & (one.episodes.cell_difficulty == difficulty)
+            ]
+            for metric in ("success", "contacts_per_step"):
+                diff = paired_difference(
+                    unit_values(cell_two, metric),
+                    unit_values(cell_one, metric),
+                    RESAMPLES,
+                    CONFIDENCE,
+                    SEED,
+                )
+                rows.append(
+                    {
+                        "two_stage": two.label,
+                        "one_stage": one.label,
+                        "seed": seed,
+                        "terrain": terrain,
+                        "difficulty": difficulty,
+                        "metric": metric,
+                        **diff,
+                    }
+                )
+    return pd.DataFrame(rows)
