@@ -1,0 +1,112 @@
+"""Run a declarative experiment file as one Hydra multirun, or plan it (`--dry-run`).
+
+    python -m lca.experiment experiments/paper_sim.yaml --dry-run [overrides]
+    python -m lca.experiment experiments/paper_sim.yaml [overrides]
+
+The file lists named policies (conf/policy/), seeds, overrides and a launcher; the multirun
+writes one run directory per (policy, seed) under runs/<name>/ and the report when it ends.
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+from omegaconf import OmegaConf
+
+from lca.config import compose
+
+REPO = Path(__file__).resolve().parents[2]
+BENCH_DIR = REPO / "reports" / "bench"
+
+
+def load_experiment(path: Path) -> dict:
+    spec = OmegaConf.to_container(OmegaConf.load(path), resolve=True)
+    for key in ("name", "policies", "seeds"):
+        if key not in spec:
+            raise ValueError(f"{path}: missing key '{key}'")
+    spec.setdefault("overrides", [])
+    spec.setdefault("launcher", "local")
+    return spec
+
+
+def sweep_command(spec: dict, extra: list[str], runs_root: str) -> list[str]:
+    return [
+        sys.executable,
+        str(REPO / "run.py"),
+        "-m",
+        f"policy={','.join(spec['policies'])}",
+        f"seed={','.join(str(s) for s in spec['seeds'])}",
+        *spec["overrides"],
+        *extra,
+        f"hydra/launcher={spec['launcher']}",
+        f"runs_root={runs_root}",
+    ]
+
+
+def estimate_seconds(overrides: list[str]) -> dict:
+    """Cost of one run from the measured benchmark throughput (reports/bench/*.json)."""
+    cfg = compose(overrides)
+    train_steps = cfg.scale.max_iterations * cfg.algo.num_steps_per_env * cfg.task.num_envs
+    ev = cfg.eval
+    eval_steps = len(ev.cells) * ev.units * ev.episodes * ev.steps
+    out = {"train_env_steps": int(train_steps), "eval_env_steps": int(eval_steps)}
+    train, env = BENCH_DIR / "train.json", BENCH_DIR / "env.json"
+    if train.exists() and env.exists():
+        train_rate = json.loads(train.read_text())["steps_per_s"]
+        rows = json.loads(env.read_text())["batched"]
+        eval_rate = max(r["steps_per_s"] for r in rows)
+        out |= {
+            "train_steps_per_s": train_rate,
+            "eval_steps_per_s": eval_rate,
+            "seconds": train_steps / train_rate + eval_steps / eval_rate,
+        }
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m lca.experiment")
+    parser.add_argument("file", type=Path)
+    parser.add_argument("--dry-run", action="store_true", help="print the plan and its cost")
+    parser.add_argument("overrides", nargs="*")
+    args = parser.parse_args(argv)
+    spec = load_experiment(args.file)
+    runs_root = next(
+        (o.split("=", 1)[1] for o in args.overrides if o.startswith("runs_root=")),
+        f"runs/{spec['name']}",
+    )
+    extra = [o for o in args.overrides if not o.startswith("runs_root=")]
+    if args.dry_run:
+        plan = list(itertools.product(spec["policies"], spec["seeds"]))
+        for policy, seed in plan:
+            print(f"  policy={policy} seed={seed} {' '.join(spec['overrides'] + extra)}")
+        cost = estimate_seconds([f"policy={spec['policies'][0]}", *spec["overrides"], *extra])
+        print(f"{len(plan)} runs into {runs_root}/ with launcher '{spec['launcher']}'")
+        print(
+            f"per run: {cost['train_env_steps']:,} training + {cost['eval_env_steps']:,} "
+            "evaluation env steps"
+        )
+        if "seconds" in cost:
+            total = cost["seconds"] * len(plan)
+            print(
+                f"estimated cost: {cost['seconds'] / 3600:.2f} h per run, {total / 3600:.1f} "
+                f"core-pair hours in all (from {cost['train_steps_per_s']:,.0f} training and "
+                f"{cost['eval_steps_per_s']:,.0f} evaluation steps/s measured by "
+                "`python -m lca.bench train|env`)"
+            )
+        else:
+            print(
+                "estimated cost: unknown (run `python -m lca.bench train` and "
+                "`python -m lca.bench env` to measure throughput)"
+            )
+        print("command:", " ".join(sweep_command(spec, extra, runs_root)))
+        return 0
+    return subprocess.call(sweep_command(spec, extra, runs_root), cwd=REPO)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
