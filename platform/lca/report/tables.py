@@ -94,22 +94,34 @@ def best_mask(means: pd.DataFrame) -> pd.DataFrame:
 
 
 def to_latex(text: pd.DataFrame, best: pd.DataFrame) -> str:
-    """Booktabs LaTeX via pandas Styler; best cells bold."""
-    styled = text.style.apply(lambda col: np.where(best[col.name], "textbf:--rwrap;", ""), axis=0)
+    """Booktabs LaTeX via pandas Styler, best cells bold, difficulty blocks introduced by an
+    italic row as in the paper (no packages beyond booktabs)."""
+    styled = text.style.apply(
+        lambda col: np.where(best[col.name], "textbf:--rwrap;", ""), axis=0
+    ).hide(axis="index", level=0)
     latex = styled.to_latex(
         hrules=True,
         multicol_align="c",
-        multirow_align="t",
-        clines="skip-last;index",
-        column_format="ll" + "c" * text.shape[1],
+        column_format="l" + "c" * text.shape[1],
         caption="Simulation results: success rate ($\\uparrow$), contacts per step "
         "($\\downarrow$), tracking error ($\\downarrow$); mean $\\pm$ standard error over units.",
         label="tab:sim_results",
         position="t",
     )
-    # booktabs rules between the difficulty blocks instead of Styler's \cline
-    cline = f"\\cline{{1-{text.index.nlevels}}}\n"
-    return latex.replace(cline + "\\bottomrule", "\\bottomrule").replace(cline, "\\midrule\n")
+    lines = latex.splitlines()
+    first_row = lines.index("\\midrule") + 1
+    blocks = text.index.get_level_values(0)
+    starts = {i: b for i, b in enumerate(blocks) if i == 0 or blocks[i - 1] != b}
+    width = text.shape[1] + 1
+    out = lines[:first_row]
+    for i, line in enumerate(lines[first_row : first_row + len(text)]):
+        if i in starts:
+            if i > 0:
+                out.append("\\addlinespace[2pt]")
+            out.append(f"\\multicolumn{{{width}}}{{l}}{{\\textit{{{starts[i]}}}}} \\\\")
+        out.append(line)
+    out += lines[first_row + len(text) :]
+    return "\n".join(out) + "\n"
 
 
 def claim_table(runs: list[RunRecord]) -> pd.DataFrame:
