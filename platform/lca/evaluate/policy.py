@@ -6,7 +6,6 @@ import contextlib
 import io
 from pathlib import Path
 
-import torch
 from omegaconf import DictConfig, OmegaConf
 from rsl_rl.runners import OnPolicyRunner
 
@@ -41,6 +40,4 @@ def load_policy(cfg: DictConfig, env: LocomotionEnv, checkpoint: Path):
     with contextlib.redirect_stdout(io.StringIO()):
         runner = OnPolicyRunner(env, build_train_cfg(cfg, "eval"), log_dir=None, device=device)
     runner.load(str(checkpoint), load_cfg={"actor": True}, strict=True, map_location=device)
-    policy = runner.get_inference_policy(device)
-    torch.set_grad_enabled(False)
-    return policy
+    return runner.get_inference_policy(device)

@@ -69,6 +69,7 @@ def cell_config(cfg: DictConfig, cell) -> DictConfig:
     return c
 
 
+@torch.inference_mode()
 def run_round(env: LocomotionEnv, policy, steps: int) -> dict[str, np.ndarray]:
     """One episode for every unit; a unit stops counting at its first termination."""
     n = env.num_envs

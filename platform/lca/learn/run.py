@@ -35,8 +35,9 @@ def train_run(cfg: DictConfig, run: RunDir) -> dict:
     threads = job_threads(cfg)
     set_torch_threads(threads)
     cfg.sim.num_threads = int(cfg.sim.num_threads) or threads
-    os.environ.setdefault("WANDB_RUN_GROUP", run.path.parent.name)
-    os.environ.setdefault("WANDB_DIR", str(run.path))
+    # each run its own wandb folder; the runs of one sweep share a group
+    os.environ["WANDB_RUN_GROUP"] = run.path.parent.name
+    os.environ["WANDB_DIR"] = str(run.path)
     for noisy in ("onnxscript", "onnx_ir", "torch.onnx"):
         logging.getLogger(noisy).setLevel(logging.WARNING)
     t0 = time.perf_counter()

@@ -80,6 +80,13 @@ class EpisodeStats:
         return out
 
 
+def _number(text: str):
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
 def _fmt_eta(seconds: float) -> str:
     seconds = int(max(seconds, 0))
     return f"{seconds // 3600:d}:{seconds % 3600 // 60:02d}:{seconds % 60:02d}"
@@ -136,10 +143,10 @@ class Trainer:
         cfg, env, alg = self.cfg, self.env, self.alg
         num_steps = int(cfg.algo.num_steps_per_env)
         stats = EpisodeStats(env.num_envs, env.device)
-        self.runner.logger.init_logging_writer()
         alg.train_mode()
         switch = curriculum.switch_iteration(cfg.curriculum, self.total)
         kept = self._curve_rows_before(self.start)
+        self.last = {k: _number(v) for k, v in kept[-1].items()} if kept else {}
         curve = self.run.curve.open("w", newline="")
         writer = csv.DictWriter(curve, fieldnames=CURVE_FIELDS)
         writer.writeheader()
@@ -148,22 +155,25 @@ class Trainer:
         obs = env.get_observations().to(self.device)
         t_start = time.perf_counter()
         try:
+            self.runner.logger.init_logging_writer()
             self._loop(writer, curve, stats, switch, obs, t_start, num_steps)
+            final = self.total - 1
+            stage = curriculum.stage_name(cfg.curriculum, final, self.total)
+            self.save(f"final_{stage}.pt", final)
+            self.save("latest.pt", final)
         finally:
             curve.close()
             self.runner.logger.stop_logging_writer()  # wandb.finish() even on failure
-        final = self.total - 1
-        self.save(f"final_{curriculum.stage_name(cfg.curriculum, final, self.total)}.pt", final)
-        self.save("latest.pt", final)
         return self.last
 
     def _loop(self, writer, curve, stats, switch, obs, t_start, num_steps) -> None:
         cfg, env, alg = self.cfg, self.env, self.alg
-        self.last = {}
         for it in range(self.start, self.total):
             if it == switch and it > 0 and not self.perception_on(it - 1):
                 self.save(f"stage1_blind_it{it - 1}.pt", it - 1)
-            env.set_perception(self.perception_on(it))
+            if self.perception_on(it) != env.perception:
+                env.set_perception(self.perception_on(it))
+                obs = env.get_observations().to(self.device)
             t0 = time.perf_counter()
             with torch.inference_mode():
                 for _ in range(num_steps):

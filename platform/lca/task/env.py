@@ -3,7 +3,7 @@
 Observation groups (TensorDict, batch [N]):
   policy         K-frame noisy proprioception history, command, last action, gait phase
   height         (N, 1, 11, 11) noisy, sparse actor map; exactly zero when perception is off
-  critic         the same proprioception without noise, plus base linear velocity
+  critic         the same proprioception without noise, plus world-frame base velocity
   critic_height  (N, 1, 16, 16) noiseless privileged map
 """
 
@@ -12,7 +12,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 import torch
-from omegaconf import DictConfig
+from omegaconf import DictConfig, OmegaConf
 from rsl_rl.env import VecEnv
 from tensordict import TensorDict
 
@@ -35,13 +35,26 @@ BAD_STATE_WARNINGS = [
 ]
 
 
+class EnvConfig:
+    """The composed config, readable like a DictConfig, with the `to_dict()` rsl-rl wants."""
+
+    def __init__(self, cfg: DictConfig):
+        self._cfg = cfg
+
+    def __getattr__(self, name: str):
+        return getattr(self._cfg, name)
+
+    def to_dict(self) -> dict:
+        return OmegaConf.to_container(self._cfg, resolve=True)
+
+
 def joint_ids(names: list[str], *patterns: str) -> np.ndarray:
     return np.array([i for i, n in enumerate(names) if any(p in n for p in patterns)], dtype=int)
 
 
 class LocomotionEnv(VecEnv):
     def __init__(self, cfg: DictConfig, scene: Scene | None = None):
-        self.cfg = cfg
+        self.cfg = EnvConfig(cfg)  # rsl-rl's loggers call cfg.to_dict()
         task = cfg.task
         self.task_cfg = task
         self.device = torch.device(resolve_device(cfg.device))
@@ -156,7 +169,7 @@ class LocomotionEnv(VecEnv):
 
     # ---- internals -----------------------------------------------------------------------
     def _bad_state_warnings(self) -> np.ndarray:
-        return self.warnings[:, BAD_STATE_WARNINGS, 0].sum(axis=1)
+        return self.warnings[:, BAD_STATE_WARNINGS, 1].sum(axis=1)  # [lastinfo, number]
 
     def _reset_envs(self, ids: np.ndarray) -> None:
         if ids.size == 0:
@@ -238,22 +251,18 @@ class LocomotionEnv(VecEnv):
             ],
             axis=1,
         )
+        self._state = state
+        actor_map = self._actor_map(state)
         yaw = yaw_of(state.base_quat)
-        xy = state.base_pos[:, :2]
-        terrain = self.scene.terrain
-        if self.perception:
-            raw = heightmap.sample_heights(terrain, xy, yaw, self.actor_offsets)
-            drop = self.task_cfg.observations.height_dropout
-            actor_map = heightmap.actor_map(raw, self.height_noise, drop, self.rng)
-        else:
-            actor_map = np.zeros((n, self.actor_offsets.shape[0]))
-        critic_raw = heightmap.sample_heights(terrain, xy, yaw, self.critic_offsets)
+        critic_raw = heightmap.sample_heights(
+            self.scene.terrain, state.base_pos[:, :2], yaw, self.critic_offsets
+        )
         critic_map = heightmap.normalise(critic_raw)
         groups = {
             "policy": np.concatenate([self.history.flat(), current], axis=1),
             "height": actor_map.reshape(n, 1, *self.actor_grid),
             "critic": np.concatenate(
-                [self.critic_history.flat(), current, state.base_lin_vel], axis=1
+                [self.critic_history.flat(), current, state.base_lin_vel_world], axis=1
             ),
             "critic_height": critic_map.reshape(n, 1, *self.critic_grid),
         }
@@ -292,8 +301,26 @@ class LocomotionEnv(VecEnv):
         return self._obs
 
     def set_perception(self, on: bool) -> None:
-        """Curriculum switch: when off the actor's map is exactly zero; the critic keeps its map."""
+        """Curriculum switch: when off the actor's map is exactly zero; the critic keeps its map.
+        The current observation's `height` group is recomputed, so the next action sees it."""
+        if bool(on) == self.perception:
+            return
         self.perception = bool(on)
+        self._obs["height"] = torch.as_tensor(
+            self._actor_map(self._state).reshape(self.num_envs, 1, *self.actor_grid),
+            dtype=torch.float32,
+            device=self.device,
+        )
+
+    def _actor_map(self, state: RobotState) -> np.ndarray:
+        if not self.perception:
+            return np.zeros((self.num_envs, self.actor_offsets.shape[0]))
+        yaw = yaw_of(state.base_quat)
+        raw = heightmap.sample_heights(
+            self.scene.terrain, state.base_pos[:, :2], yaw, self.actor_offsets
+        )
+        drop = self.task_cfg.observations.height_dropout
+        return heightmap.actor_map(raw, self.height_noise, drop, self.rng)
 
 
 def _sanitise(state: RobotState, broken: np.ndarray) -> RobotState:

@@ -32,7 +32,7 @@ def describe_task(cfg: DictConfig) -> dict:
     current = observations.current_terms(num_joints)
     policy_terms = [_term(t, k, noisy) for t in hist] + [_term(t) for t in current]
     critic_terms = [_term(t, k, noisy=False) for t in hist] + [_term(t) for t in current]
-    critic_terms.append({"name": "base_lin_vel", "dim": 3, "scale": 1.0, "noise": 0.0})
+    critic_terms.append({"name": "base_lin_vel_world", "dim": 3, "scale": 1.0, "noise": 0.0})
     ar, ac = task.observations.actor_grid
     cr, cc = task.observations.critic_grid
     height_noise = float(cfg.difficulty.height_noise) if noisy else 0.0

@@ -43,6 +43,7 @@ class RobotState:
     base_pos: np.ndarray  # (N, 3) world
     base_quat: np.ndarray  # (N, 4) wxyz
     base_lin_vel: np.ndarray  # (N, 3) body frame
+    base_lin_vel_world: np.ndarray  # (N, 3) world frame (critic, as in the paper)
     base_ang_vel: np.ndarray  # (N, 3) body frame
     projected_gravity: np.ndarray  # (N, 3) unit gravity in the body frame
     base_height: np.ndarray  # (N,) above the terrain under the base
@@ -83,12 +84,14 @@ class ContactAccumulator:
     def update(self) -> None:
         for i, sensor in enumerate(self.feet):
             force = sensor[:, 1:4]
-            np.maximum(self.foot_force[:, i], np.linalg.norm(force, axis=1), self.foot_force[:, i])
+            np.maximum(
+                self.foot_force[:, i], np.linalg.norm(force, axis=1), out=self.foot_force[:, i]
+            )
             lateral = np.linalg.norm(force[:, :2], axis=1)
-            np.maximum(self.foot_lateral[:, i], lateral, self.foot_lateral[:, i])
+            np.maximum(self.foot_lateral[:, i], lateral, out=self.foot_lateral[:, i])
         for i, sensor in enumerate(self.legs):
             force = np.linalg.norm(sensor[:, 1:4], axis=1)
-            np.maximum(self.leg_force[:, i], force, self.leg_force[:, i])
+            np.maximum(self.leg_force[:, i], force, out=self.leg_force[:, i])
 
 
 def read_state(sim: BatchedSim, contacts: ContactAccumulator) -> RobotState:
@@ -101,6 +104,7 @@ def read_state(sim: BatchedSim, contacts: ContactAccumulator) -> RobotState:
         base_pos=base_pos,
         base_quat=qpos[:, 3:7].copy(),
         base_lin_vel=sim.sensor("imu_lin_vel").copy(),
+        base_lin_vel_world=sim.sensor("base_lin_vel_world").copy(),
         base_ang_vel=sim.sensor("imu_ang_vel").copy(),
         projected_gravity=-sim.sensor("imu_up"),
         base_height=base_pos[:, 2] - height_at(base_pos[:, 0], base_pos[:, 1]),

@@ -1,0 +1,54 @@
+"""Velocity commands and the gait clock."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lca.config.schema import CommandConfig
+from lca.task.commands import VelocityCommand, gait_phase
+
+
+def test_gait_phase_left_and_right_half_a_period_apart():
+    t = np.array([0.0, 0.2, 0.6, 0.8, 1.0])
+    phase = gait_phase(t, 0.8)
+    np.testing.assert_allclose(phase[:, 0], [0.0, 0.25, 0.75, 0.0, 0.25], atol=1e-12)
+    np.testing.assert_allclose(phase[:, 1], [0.5, 0.75, 0.25, 0.5, 0.75], atol=1e-12)
+    assert ((phase >= 0) & (phase < 1)).all()
+
+
+def test_resample_ranges_and_standing_share():
+    cfg = CommandConfig()
+    n = 20000
+    cmd = VelocityCommand(cfg, n, dt=0.02, rng=np.random.default_rng(0))
+    cmd.resample(np.arange(n))
+    v = cmd.value
+    for k, (lo, hi) in enumerate([cfg.lin_vel_x, cfg.lin_vel_y, cfg.ang_vel_z]):
+        assert v[:, k].min() >= lo and v[:, k].max() <= hi
+    zero = (v == 0).all(axis=1)
+    assert zero.mean() == pytest.approx(cfg.standing_fraction, abs=0.01)
+    np.testing.assert_array_equal(cmd.standing, np.linalg.norm(v, axis=1) < 5e-3)
+    assert cmd.standing[zero].all()
+    np.testing.assert_allclose(cmd.time_left, cfg.resample_time_s)
+
+
+def test_resample_only_touches_the_given_envs():
+    cmd = VelocityCommand(CommandConfig(standing_fraction=0.0), 4, 0.02, np.random.default_rng(1))
+    cmd.resample(np.array([1, 3]))
+    assert (cmd.value[[0, 2]] == 0).all()
+    assert (cmd.value[[1, 3]] != 0).all()
+    assert not cmd.standing[[1, 3]].any() and cmd.standing[[0, 2]].all()
+    cmd.resample(np.array([], dtype=int))  # no-op
+
+
+def test_update_resamples_after_the_resample_time():
+    cfg = CommandConfig(resample_time_s=0.1, standing_fraction=0.0)
+    cmd = VelocityCommand(cfg, 2, dt=0.02, rng=np.random.default_rng(2))
+    cmd.resample(np.arange(2))
+    first = cmd.value.copy()
+    for _ in range(4):  # 0.08 s
+        cmd.update()
+    np.testing.assert_array_equal(cmd.value, first)
+    for _ in range(2):  # 0.10 s (+ one step of float round-off)
+        cmd.update()
+    assert (cmd.value != first).all()
