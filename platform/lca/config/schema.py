@@ -255,6 +255,41 @@ class TaskConfig:
             )
 
 
+@dataclass
+class CameraConfig:
+    body: str = MISSING
+    pos: list[float] = MISSING  # m, in the body frame
+    pitch_deg: float = 60.0  # optical axis below horizontal
+    yaw_deg: float = 0.0  # 180 looks backwards
+    fov_h_deg: float = 87.0  # Intel RealSense D435 depth field of view
+    fov_v_deg: float = 58.0
+    rays_h: int = 24  # ray grid subsampling the D435's 848 x 480 (CPU cost)
+    rays_w: int = 36
+    min_range: float = 0.1
+    max_range: float = 3.0
+    noise_k: float = 0.004  # depth noise sigma = k d^2 (stereo error grows with d^2)
+    invalid_fraction: float = 0.02  # pixels with no depth
+
+
+@dataclass
+class PerceptionConfig:
+    name: str = "privileged"
+    source: str = "privileged"  # privileged: exact grid + noise; deployment: cameras + filter
+    rate_hz: float = 30.0  # camera rate; the 50 Hz policy reads the latest map
+    outlier_gamma: float = 2.0  # cells with |g - mu| >= gamma sigma are set to mu
+    quantum: float = 0.05  # m, map quantisation (paper)
+    cameras: list[CameraConfig] = field(default_factory=list)
+
+    def check(self) -> None:
+        allowed = ("privileged", "deployment")
+        _require(self.source in allowed, "perception.source", f"allowed: {allowed}")
+        _require(
+            self.source == "privileged" or len(self.cameras) > 0,
+            "perception.cameras",
+            "the deployment pipeline needs at least one camera",
+        )
+
+
 ACTOR_KINDS = ("mlp", "lstm")
 ENCODER_KINDS = ("cnn", "mlp")
 
@@ -397,6 +432,7 @@ class LcaConfig:
     terrain: TerrainConfig = field(default_factory=TerrainConfig)
     difficulty: DifficultyConfig = field(default_factory=DifficultyConfig)
     task: TaskConfig = field(default_factory=TaskConfig)
+    perception: PerceptionConfig = field(default_factory=PerceptionConfig)
     actor: ActorConfig = field(default_factory=ActorConfig)
     encoder: EncoderConfig = field(default_factory=EncoderConfig)
     curriculum: CurriculumConfig = field(default_factory=CurriculumConfig)

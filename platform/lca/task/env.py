@@ -18,8 +18,9 @@ from tensordict import TensorDict
 
 from lca.config.runtime import resolve_device
 from lca.sim.batch import BatchedSim
+from lca.sim.depth_camera import CameraSpec, DepthCameras
 from lca.sim.scene import Scene, build_scene
-from lca.task import heightmap, observations
+from lca.task import heightmap, observations, perception
 from lca.task.commands import VelocityCommand, gait_phase
 from lca.task.rewards import RewardContext, compute_rewards
 from lca.task.state import ContactAccumulator, RobotState, read_state, yaw_of
@@ -90,6 +91,13 @@ class LocomotionEnv(VecEnv):
         self.critic_offsets = heightmap.grid_offsets(self.critic_grid, obs.critic_spacing)
 
         self.commands = VelocityCommand(task.commands, self.num_envs, self.dt, self.rng)
+        self.perception_cfg = cfg.perception
+        self.cameras = None
+        if cfg.perception.source == "deployment":
+            specs = [CameraSpec(**OmegaConf.to_container(c)) for c in cfg.perception.cameras]
+            self.cameras = DepthCameras(self.sim, specs, self.rng)
+            self._camera_frame = np.full(self.num_envs, -1)
+            self._deployment_map = np.zeros((self.num_envs, self.actor_offsets.shape[0]))
         self.contacts = ContactAccumulator(self.sim)
         self.warnings = self.sim.batch.bind("warning")
         self.episode_length_buf = torch.zeros(self.num_envs, dtype=torch.long, device=self.device)
@@ -180,6 +188,8 @@ class LocomotionEnv(VecEnv):
             self.sim.set_friction_scale(ids, self.rng.uniform(*rand.friction, ids.size))
         self.commands.resample(ids)
         self._episode_steps[ids] = 0
+        if self.cameras is not None:
+            self._camera_frame[ids] = -1
         self.action[ids] = 0.0
         self.last_action[ids] = 0.0
         for sums in self.episode_sums.values():
@@ -286,10 +296,34 @@ class LocomotionEnv(VecEnv):
             "track_error": np.linalg.norm(error, axis=1),
         }
 
+    def _camera_map(self, state: RobotState) -> np.ndarray:
+        """The latest deployment map: cameras fire at `rate_hz`; between frames the policy
+        reads the last map (a reset env gets a fresh frame at once)."""
+        frame = np.floor(self._episode_steps * self.dt * self.perception_cfg.rate_hz)
+        due = frame != self._camera_frame
+        if due.any():
+            points, valid = self.cameras.capture()
+            obs = self.task_cfg.observations
+            fresh = perception.deployment_map(
+                points,
+                valid,
+                state.base_pos[:, :2],
+                yaw_of(state.base_quat),
+                tuple(obs.actor_grid),
+                obs.actor_spacing,
+                self.perception_cfg.outlier_gamma,
+                self.perception_cfg.quantum,
+            )
+            self._deployment_map[due] = fresh[due]
+            self._camera_frame = np.where(due, frame, self._camera_frame)
+        return self._deployment_map.copy()
+
     def reseed(self, seed: int) -> None:
         """Restart every random stream (resets, noise, commands) from `seed`."""
         self.rng = np.random.default_rng(seed)
         self.commands.rng = self.rng
+        if self.cameras is not None:
+            self.cameras.rng = self.rng
         self.sim.rng = np.random.default_rng(seed + 1)
 
     def reset_all(self) -> TensorDict:
@@ -315,6 +349,8 @@ class LocomotionEnv(VecEnv):
     def _actor_map(self, state: RobotState) -> np.ndarray:
         if not self.perception:
             return np.zeros((self.num_envs, self.actor_offsets.shape[0]))
+        if self.cameras is not None:
+            return self._camera_map(state)
         yaw = yaw_of(state.base_quat)
         raw = heightmap.sample_heights(
             self.scene.terrain, state.base_pos[:, :2], yaw, self.actor_offsets
