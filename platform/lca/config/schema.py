@@ -290,6 +290,62 @@ class PerceptionConfig:
         )
 
 
+HARDWARE_TASKS = ("stair_ascent", "stair_descent", "hinged_ledge", "soft_ledge")
+
+
+@dataclass
+class StairTaskConfig:
+    steps: int = 3
+    riser: float = 0.18  # m
+    landing: float = 0.20  # m, tread depth
+    skew_deg: float = 25.0  # stair edges rotated in the horizontal plane
+
+
+@dataclass
+class HingedPlankConfig:
+    length: float = 1.2  # m
+    width: float = 0.6
+    thickness: float = 0.04
+    pivot_height: float = 0.10  # m, plank centre above the ground when level
+    tip_deg: float = 12.0  # hinge range: the plank tips this far either way
+    mass: float = 6.0  # kg
+    damping: float = 2.0  # N m s / rad
+
+
+@dataclass
+class SoftMatConfig:
+    length: float = 1.2  # m
+    width: float = 1.0
+    thickness: float = 0.10
+    solref: list[float] = field(default_factory=lambda: [0.08, 0.7])  # soft: slow, underdamped
+    solimp: list[float] = field(default_factory=lambda: [0.3, 0.9, 0.06, 0.5, 2.0])
+
+
+@dataclass
+class HardwareConfig:
+    name: str = "default"
+    tasks: list[str] = field(default_factory=lambda: list(HARDWARE_TASKS))
+    trials: int = 5
+    command_x: float = 0.3  # m/s forward from a standing start (paper)
+    time_limit_s: float = 20.0
+    approach: float = 1.0  # m of flat ground (or platform) before the feature
+    goal_past: float = 0.6  # m past the feature's end that counts as completed
+    ledge_drop: float = 0.36  # m (paper)
+    resolution: float = 0.01  # m, heightfield of the static geometry
+    stairs: StairTaskConfig = field(default_factory=StairTaskConfig)
+    plank: HingedPlankConfig = field(default_factory=HingedPlankConfig)
+    mat: SoftMatConfig = field(default_factory=SoftMatConfig)
+
+    def check(self) -> None:
+        for task in self.tasks:
+            _require(
+                task in HARDWARE_TASKS,
+                "hardware.tasks",
+                f"unknown '{task}'; allowed: {HARDWARE_TASKS}",
+            )
+        _require(self.trials >= 1, "hardware.trials", "must be >= 1")
+
+
 ACTOR_KINDS = ("mlp", "lstm")
 ENCODER_KINDS = ("cnn", "mlp")
 
@@ -433,6 +489,7 @@ class LcaConfig:
     difficulty: DifficultyConfig = field(default_factory=DifficultyConfig)
     task: TaskConfig = field(default_factory=TaskConfig)
     perception: PerceptionConfig = field(default_factory=PerceptionConfig)
+    hardware: HardwareConfig = field(default_factory=HardwareConfig)
     actor: ActorConfig = field(default_factory=ActorConfig)
     encoder: EncoderConfig = field(default_factory=EncoderConfig)
     curriculum: CurriculumConfig = field(default_factory=CurriculumConfig)

@@ -4,9 +4,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pandas as pd
+
 from lca.report.collect import find_run_dirs, load_run
-from lca.report.dashboard import write_dashboard
+from lca.report.dashboard import hardware_section, write_dashboard
 from lca.report.figures import plot_rewards
+from lca.report.hardware_table import hardware_table
 from lca.report.tables import (
     best_mask,
     claim_table,
@@ -36,4 +39,14 @@ def build_report(paths: list[Path], out_dir: Path) -> Path:
     claim = claim_table(runs)
     claim.to_csv(out_dir / "claim.csv", index=False)
     plot_rewards(runs, out_dir / "training_rewards")
-    return write_dashboard(out_dir, runs, text, best, claim)
+    hardware_html = ""
+    trials = {}
+    for run in runs:
+        if run.hardware is not None:
+            trials[run.label] = pd.concat([trials.get(run.label), run.hardware])
+    if trials:
+        hw_table, hw_latex = hardware_table(trials)
+        hw_table.to_csv(out_dir / "hardware_table.csv", index=False)
+        (out_dir / "hardware_table.tex").write_text(hw_latex)
+        hardware_html = hardware_section(hw_table)
+    return write_dashboard(out_dir, runs, text, best, claim, hardware_html)

@@ -50,6 +50,7 @@ class RunRecord:
     provenance: dict
     episodes: pd.DataFrame | None
     curve: pd.DataFrame | None
+    hardware: pd.DataFrame | None = None
 
     @property
     def name(self) -> str:
@@ -76,6 +77,7 @@ def load_run(path: Path) -> RunRecord:
     provenance = json.loads((path / "provenance.json").read_text())
     results = path / "results.parquet"
     curve = path / "train_curve.csv"
+    hardware = path / "hardware.csv"
     return RunRecord(
         path=path,
         label=policy_label(cfg.curriculum.name, cfg.actor.kind, cfg.encoder.kind),
@@ -86,4 +88,5 @@ def load_run(path: Path) -> RunRecord:
         provenance=provenance,
         episodes=pd.read_parquet(results) if results.exists() else None,
         curve=pd.read_csv(curve) if curve.exists() else None,
+        hardware=pd.read_csv(hardware) if hardware.exists() else None,
     )

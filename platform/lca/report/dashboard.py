@@ -32,6 +32,7 @@ Downloads: <a href="sim_table.tex">LaTeX</a>, <a href="sim_table.csv">CSV</a>.</
 <p>Two-stage minus its one-stage twin (same actor, encoder and seed; units paired by common
 random numbers), 95 % paired bootstrap CI. <a href="claim.csv">CSV</a>.</p>
 {{ claim_table }}
+{{ hardware }}
 <h2 id="training">Training rewards</h2>
 <img src="training_rewards.png" alt="training rewards">
 <h2 id="runs">Runs</h2>
@@ -82,7 +83,22 @@ def sim_table_html(text: pd.DataFrame, best: pd.DataFrame) -> str:
     return styled.set_table_attributes('id="sim-table"').to_html()
 
 
-def write_dashboard(out_dir: Path, runs, text, best, claim: pd.DataFrame) -> Path:
+def hardware_section(table: pd.DataFrame) -> str:
+    shown = table.assign(
+        success=table.successes.astype(str) + "/" + table.trials.astype(str),
+        drift_m=table.drift_m.round(3),
+    )[["policy", "task", "success", "drift_m"]]
+    return (
+        '<h2 id="hardware">Hardware-style tasks (simulation)</h2>\n'
+        "<p>Success over trials and mean lateral drift of the successful trials. "
+        '<a href="hardware_table.tex">LaTeX</a>, <a href="hardware_table.csv">CSV</a>.</p>\n'
+        + shown.to_html(index=False, table_id="hardware-table")
+    )
+
+
+def write_dashboard(
+    out_dir: Path, runs, text, best, claim: pd.DataFrame, hardware: str = ""
+) -> Path:
     claim_html = (
         claim.round(3).to_html(index=False, table_id="claim-table")
         if not claim.empty
@@ -94,6 +110,7 @@ def write_dashboard(out_dir: Path, runs, text, best, claim: pd.DataFrame) -> Pat
         sim_table=sim_table_html(text, best),
         claim_table=claim_html,
         runs_table=runs_table(runs, out_dir),
+        hardware=hardware,
     )
     path = out_dir / "index.html"
     path.write_text(page)

@@ -44,6 +44,10 @@ class BatchedSim:
         self._nominal_friction = self.model.geom_friction[:, 0].copy()
         self._nominal_mass = self.model.body_mass.copy()
         self.base_body = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, g1.BASE_BODY)
+        # The robot's joints come first; task objects (a hinged plank) may follow them.
+        num_joints = len(scene.joint_names)
+        self.joint_qpos = slice(7, 7 + num_joints)
+        self.joint_dof = slice(6, 6 + num_joints)
 
     def sensor(self, name: str) -> np.ndarray:
         return self.batch.sensor(name)
@@ -73,11 +77,13 @@ class BatchedSim:
         qpos[:, :2] = xy
         qpos[:, 2] = ground + self.scene.base_height
         qpos[:, 3:7] = yaw_quat(yaw)
-        qpos[:, 7:] = joints
+        qpos[:, self.joint_qpos] = joints
         self.qpos[ids] = qpos
         if noise is not None and noise.joint_vel_noise > 0:
             qvel = self.qvel[ids]
-            qvel[:, 6:] = self.rng.uniform(-noise.joint_vel_noise, noise.joint_vel_noise, (n, 29))
+            qvel[:, self.joint_dof] = self.rng.uniform(
+                -noise.joint_vel_noise, noise.joint_vel_noise, joints.shape
+            )
             self.qvel[ids] = qvel
         self.ctrl[ids] = self.scene.home_joint_pos
         self.batch.forward(ids)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import mujoco
@@ -88,8 +89,13 @@ def standing_base_height(spec_model: mujoco.MjModel, joint_pos: np.ndarray) -> f
     return 1.0 - lowest
 
 
-def build_scene(cfg: DictConfig, terrain: Terrain | None = None) -> Scene:
-    """The compiled model for a composed config: G1 + terrain + physics options + `home`."""
+def build_scene(
+    cfg: DictConfig,
+    terrain: Terrain | None = None,
+    decorate: Callable[[mujoco.MjSpec], None] | None = None,
+) -> Scene:
+    """The compiled model for a composed config: G1 + terrain + physics options + `home`.
+    `decorate(spec)` may add task objects (bodies, joints) before compilation."""
     robot_cfg: RobotConfig = cfg.robot
     spec = g1.build_robot_spec(robot_cfg)
     apply_sim_options(spec, cfg.sim)
@@ -99,6 +105,8 @@ def build_scene(cfg: DictConfig, terrain: Terrain | None = None) -> Scene:
 
     terrain = terrain if terrain is not None else generate(cfg.terrain, cfg.difficulty)
     add_terrain(spec, terrain)
+    if decorate is not None:
+        decorate(spec)
     x, y = terrain.tiles[0].centre
     ground = float(terrain.height_at(x, y))
     home_qpos = np.concatenate([[x, y, ground + base_height, 1.0, 0.0, 0.0, 0.0], home_joints])

@@ -72,7 +72,7 @@ class LocomotionEnv(VecEnv):
         self.hip_ids = joint_ids(names, "hip_roll", "hip_yaw")
         self.arm_ids = joint_ids(names, "shoulder", "elbow", "wrist")
         self.torso_ids = joint_ids(names, "waist")
-        lower, upper = self.scene.model.jnt_range[1:].T
+        lower, upper = self.scene.model.jnt_range[1 : 1 + self.num_actions].T
         mid, half = (lower + upper) / 2, (upper - lower) / 2 * task.reward_params.soft_limit_factor
         self.joint_lower, self.joint_upper = mid - half, mid + half
         self.weights = {k: float(v) for k, v in task.rewards.items()}
@@ -294,6 +294,7 @@ class LocomotionEnv(VecEnv):
             "time_out": time_out.copy(),
             "lateral_impact": (state.foot_lateral_force > threshold).any(axis=1),
             "track_error": np.linalg.norm(error, axis=1),
+            "base_pos": state.base_pos.copy(),
         }
 
     def _camera_map(self, state: RobotState) -> np.ndarray:

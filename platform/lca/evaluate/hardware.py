@@ -1,0 +1,98 @@
+"""The paper's hardware protocol in simulation: per task, N trials from a standing start
+with a 0.3 m/s forward command, stopping when the task is completed.
+
+success = the base passes the task's goal line without a fall within the time limit;
+drift = |lateral base displacement| at completion; precision = mean drift over the
+successful trials. Blind policies run with perception off, the others through the
+deployment perception pipeline (depth cameras -> filtered 11 x 11 map).
+"""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import torch
+from omegaconf import DictConfig, OmegaConf
+
+from lca.config import conf_dir, schema
+from lca.evaluate.policy import final_checkpoint, load_policy
+from lca.learn import curriculum
+from lca.learn.rundir import atomic_write
+from lca.sim.hardware import HardwareTask, build_task
+from lca.task.env import LocomotionEnv
+
+
+def deployment_perception() -> DictConfig:
+    loaded = OmegaConf.load(conf_dir() / "perception" / "deployment.yaml")
+    return OmegaConf.merge(OmegaConf.structured(schema.PerceptionConfig), loaded)
+
+
+def task_config(cfg: DictConfig) -> DictConfig:
+    c = copy.deepcopy(cfg)
+    hw = cfg.hardware
+    c.task.num_envs = hw.trials
+    c.task.episode_length_s = hw.time_limit_s
+    c.task.randomization.enabled = False
+    c.task.reset.yaw_range = 0.0  # facing the task
+    c.task.reset.base_xy_noise = 0.0
+    c.task.commands.lin_vel_x = [hw.command_x, hw.command_x]
+    c.task.commands.lin_vel_y = [0.0, 0.0]
+    c.task.commands.ang_vel_z = [0.0, 0.0]
+    c.task.commands.standing_fraction = 0.0
+    c.task.commands.resample_time_s = 2 * hw.time_limit_s
+    c.perception = deployment_perception()
+    return c
+
+
+@torch.inference_mode()
+def run_trials(env: LocomotionEnv, policy, task: HardwareTask, steps: int) -> pd.DataFrame:
+    n = env.num_envs
+    obs = env.reset_all()
+    policy.reset(torch.ones(n, dtype=torch.bool, device=env.device))
+    start_y = env.sim.qpos[:, 1].copy()
+    active = np.ones(n, dtype=bool)
+    success = np.zeros(n, dtype=bool)
+    drift = np.full(n, np.nan)
+    time_s = np.full(n, np.nan)
+    for step in range(steps):
+        obs, _, dones, extras = env.step(policy(obs))
+        m = extras["metrics"]
+        done_now = active & (m["base_pos"][:, 0] >= task.goal_x) & ~m["terminated"]
+        success |= done_now
+        drift = np.where(done_now, np.abs(m["base_pos"][:, 1] - start_y), drift)
+        time_s = np.where(done_now, (step + 1) * env.dt, time_s)
+        active &= ~(done_now | m["terminated"] | m["time_out"])
+        policy.reset(dones.bool())
+        if not active.any():
+            break
+    return pd.DataFrame(
+        {"trial": np.arange(n), "success": success, "drift_m": drift, "time_s": time_s}
+    )
+
+
+def run_hardware(run_dir: Path, cfg: DictConfig, log=print) -> pd.DataFrame:
+    """Every task of `cfg.hardware` on the run's final policy; writes hardware.csv."""
+    run_dir = Path(run_dir)
+    c = task_config(cfg)
+    total = int(cfg.scale.max_iterations)
+    perception = curriculum.perception_on(cfg.curriculum, total - 1, total)
+    checkpoint = final_checkpoint(run_dir)
+    steps = int(round(c.hardware.time_limit_s / (c.sim.timestep * c.sim.decimation)))
+    frames = []
+    for name in c.hardware.tasks:
+        task, scene = build_task(c, name)
+        env = LocomotionEnv(c, scene=scene)
+        env.set_perception(perception)
+        env.reseed(c.eval.seed)
+        policy = load_policy(c, env, checkpoint)
+        trials = run_trials(env, policy, task, steps)
+        trials.insert(0, "task", name)
+        frames.append(trials)
+        if log:
+            log(f"[lca] hardware {run_dir.name} {name}: {int(trials.success.sum())}/{len(trials)}")
+    result = pd.concat(frames, ignore_index=True)
+    atomic_write(run_dir / "hardware.csv", result.to_csv(index=False))
+    return result

@@ -1,0 +1,1 @@
+"""`python -m lca.hardware run_dir=<dir>`: the paper's four hardware tasks in simulation."""

@@ -1,0 +1,32 @@
+"""`python -m lca.hardware.scenes [overrides] [out=DIR]`: write the four task scenes (G1 in
+its `home` keyframe at the start) as MJCF + binary models, for plain MuJoCo."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import mujoco
+
+from lca.config import compose
+from lca.sim.hardware import TASKS, build_task
+
+DEFAULT_OUT = Path(__file__).resolve().parents[3] / "assets" / "hardware"
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = list(sys.argv[1:] if argv is None else argv)
+    outs = [a.split("=", 1)[1] for a in args if a.startswith("out=")]
+    out = Path(outs[0]) if outs else DEFAULT_OUT
+    out.mkdir(parents=True, exist_ok=True)
+    cfg = compose([a for a in args if not a.startswith("out=")])
+    for name in TASKS:
+        _, scene = build_task(cfg, name)
+        path = out / f"{name}.mjb"
+        mujoco.mj_saveModel(scene.model, str(path), None)
+        print(f"wrote {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
