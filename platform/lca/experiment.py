@@ -31,6 +31,8 @@ def load_experiment(path: Path) -> dict:
             raise ValueError(f"{path}: missing key '{key}'")
     spec.setdefault("overrides", [])
     spec.setdefault("launcher", "local")
+    spec.setdefault("table", "simulation")
+    spec.setdefault("runs_root", f"runs/{spec['name']}")
     return spec
 
 
@@ -77,7 +79,7 @@ def main(argv: list[str] | None = None) -> int:
     spec = load_experiment(args.file)
     runs_root = next(
         (o.split("=", 1)[1] for o in args.overrides if o.startswith("runs_root=")),
-        f"runs/{spec['name']}",
+        spec["runs_root"],
     )
     extra = [o for o in args.overrides if not o.startswith("runs_root=")]
     if args.dry_run:
@@ -90,6 +92,8 @@ def main(argv: list[str] | None = None) -> int:
             f"per run: {cost['train_env_steps']:,} training + {cost['eval_env_steps']:,} "
             "evaluation env steps"
         )
+        if spec["table"] == "hardware":
+            print("then: `python -m lca.hardware` on each run (4 tasks x trials), and the report")
         if "seconds" in cost:
             total = cost["seconds"] * len(plan)
             print(
@@ -105,7 +109,31 @@ def main(argv: list[str] | None = None) -> int:
             )
         print("command:", " ".join(sweep_command(spec, extra, runs_root)))
         return 0
-    return subprocess.call(sweep_command(spec, extra, runs_root), cwd=REPO)
+    training = [o for o in extra if not o.startswith("hardware.")]  # not part of a run's identity
+    code = subprocess.call(sweep_command(spec, training, runs_root), cwd=REPO)
+    if code != 0 or spec["table"] != "hardware":
+        return code
+    return run_hardware_stage(spec, extra, Path(REPO, runs_root))
+
+
+def run_hardware_stage(spec: dict, extra: list[str], runs_root: Path) -> int:
+    """The hardware tasks on every run of this experiment, then the report."""
+    from lca.evaluate.hardware import run_hardware
+    from lca.evaluate.policy import load_run_config
+    from lca.report.build import build_report
+    from lca.report.collect import find_run_dirs
+
+    wanted = {f"policy={p}" for p in spec["policies"]}
+    runs = []
+    for run_dir in find_run_dirs([runs_root]):
+        overrides = json.loads((run_dir / "provenance.json").read_text())["overrides"]
+        if wanted & set(overrides):
+            hw = [o for o in extra if o.startswith("hardware.")]
+            run_hardware(run_dir, load_run_config(run_dir, hw))
+            runs.append(run_dir)
+    index = build_report(runs, runs_root / "report_hardware")
+    print(f"[lca] hardware report: {index}")
+    return 0
 
 
 if __name__ == "__main__":
