@@ -2,24 +2,25 @@
 
 The robot starts at the origin facing +x. Static geometry (ground, steps, ledge platforms) is
 a heightfield, so the task layer's exact height queries still hold; the hinged plank and the
-soft mat are bodies on top of it. `python -m lca.hardware.scenes` writes each scene's MJCF
-into assets/hardware/ for inspection with plain MuJoCo.
+soft mat are the project's own MJCF (assets/hardware/*.xml) attached on top of it, resized
+from the config. `python -m lca.hardware.scenes` writes each whole scene as a binary model.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 
 import mujoco
 import numpy as np
 from omegaconf import DictConfig
 
 from lca.config.schema import HardwareConfig
-from lca.sim import robot as g1
 from lca.sim.scene import Scene, build_scene
 from lca.sim.terrain import Terrain, Tile
 
+ASSETS = Path(__file__).resolve().parents[3] / "assets" / "hardware"
 EXTENT_X = (-1.5, 6.0)  # m, heightfield extent around the task
 EXTENT_Y = (-2.0, 2.0)
 
@@ -66,43 +67,35 @@ def _platform(cfg: HardwareConfig, top: float) -> np.ndarray:
     return np.where(x < cfg.approach, top, 0.0)
 
 
+def _attach(spec: mujoco.MjSpec, asset: str, pos: list[float]) -> mujoco.MjSpec:
+    """Load assets/hardware/<asset>.xml and attach its bodies to `spec` at `pos`."""
+    child = mujoco.MjSpec.from_file(str(ASSETS / f"{asset}.xml"))
+    frame = spec.worldbody.add_frame(pos=pos)
+    for body in list(child.worldbody.bodies):
+        frame.attach_body(body, "", "")
+    return spec
+
+
 def hinged_ledge(cfg: HardwareConfig) -> HardwareTask:
     """A platform `ledge_drop` above a plank that pivots about its centre."""
     p = cfg.plank
     plank_top = p.pivot_height + p.thickness / 2
     heights = _platform(cfg, plank_top + cfg.ledge_drop)
     centre_x = cfg.approach + p.length / 2
+    support_half = (p.pivot_height - p.thickness / 2 - 0.01) / 2
 
     def decorate(spec: mujoco.MjSpec) -> None:
-        support = spec.worldbody.add_body(name="pivot_support", pos=[centre_x, 0, 0])
-        support.add_geom(
-            name="pivot_support",
-            type=mujoco.mjtGeom.mjGEOM_BOX,
-            size=[0.03, p.width / 2, (p.pivot_height - p.thickness / 2 - 0.01) / 2],
-            pos=[0, 0, (p.pivot_height - p.thickness / 2 - 0.01) / 2],
-            contype=g1.TERRAIN_CONTYPE,
-            conaffinity=g1.TERRAIN_CONAFFINITY,
-            rgba=[0.3, 0.3, 0.3, 1],
-        )
-        plank = spec.worldbody.add_body(name="plank", pos=[centre_x, 0, p.pivot_height])
-        plank.add_joint(
-            name="plank_hinge",
-            type=mujoco.mjtJoint.mjJNT_HINGE,
-            axis=[0, 1, 0],
-            range=[-np.radians(p.tip_deg), np.radians(p.tip_deg)],
-            limited=mujoco.mjtLimited.mjLIMITED_TRUE,
-            damping=p.damping,
-        )
-        plank.add_geom(
-            name="plank",
-            type=mujoco.mjtGeom.mjGEOM_BOX,
-            size=[p.length / 2, p.width / 2, p.thickness / 2],
-            mass=p.mass,
-            contype=g1.TERRAIN_CONTYPE,
-            conaffinity=g1.TERRAIN_CONAFFINITY,
-            condim=3,
-            rgba=[0.6, 0.45, 0.25, 1],
-        )
+        _attach(spec, "hinged_plank", [centre_x, 0.0, 0.0])
+        support = spec.geom("pivot_support")
+        support.size = [0.03, p.width / 2, support_half]
+        support.pos = [0, 0, support_half]
+        spec.body("plank").pos = [0, 0, p.pivot_height]
+        hinge = spec.joint("plank_hinge")
+        hinge.range = [-np.radians(p.tip_deg), np.radians(p.tip_deg)]
+        hinge.damping = [p.damping, 0.0, 0.0] if hasattr(hinge.damping, "__len__") else p.damping
+        plank = spec.geom("plank")
+        plank.size = [p.length / 2, p.width / 2, p.thickness / 2]
+        plank.mass = p.mass
 
     goal = cfg.approach + p.length + cfg.goal_past
     return HardwareTask(
@@ -116,19 +109,12 @@ def soft_ledge(cfg: HardwareConfig) -> HardwareTask:
     heights = _platform(cfg, m.thickness + cfg.ledge_drop)
 
     def decorate(spec: mujoco.MjSpec) -> None:
-        spec.worldbody.add_geom(
-            name="soft_mat",
-            type=mujoco.mjtGeom.mjGEOM_BOX,
-            size=[m.length / 2, m.width / 2, m.thickness / 2],
-            pos=[cfg.approach + m.length / 2, 0, m.thickness / 2],
-            contype=g1.TERRAIN_CONTYPE,
-            conaffinity=g1.TERRAIN_CONAFFINITY,
-            condim=3,
-            solref=list(m.solref),
-            solimp=list(m.solimp),
-            priority=1,  # its soft contact parameters win over the robot's
-            rgba=[0.2, 0.35, 0.8, 1],
-        )
+        _attach(spec, "soft_mat", [cfg.approach + m.length / 2, 0.0, 0.0])
+        mat = spec.geom("soft_mat")
+        mat.size = [m.length / 2, m.width / 2, m.thickness / 2]
+        mat.pos = [0, 0, m.thickness / 2]
+        mat.solref = list(m.solref)
+        mat.solimp = list(m.solimp)
 
     goal = cfg.approach + m.length + cfg.goal_past
     return HardwareTask(
