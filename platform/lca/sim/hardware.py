@@ -92,7 +92,7 @@ def hinged_ledge(cfg: HardwareConfig) -> HardwareTask:
         spec.body("plank").pos = [0, 0, p.pivot_height]
         hinge = spec.joint("plank_hinge")
         hinge.range = [-np.radians(p.tip_deg), np.radians(p.tip_deg)]
-        hinge.damping = [p.damping, 0.0, 0.0] if hasattr(hinge.damping, "__len__") else p.damping
+        hinge.damping = [p.damping, 0.0, 0.0]  # MjsJoint.damping is a 3-vector; [0] is linear
         plank = spec.geom("plank")
         plank.size = [p.length / 2, p.width / 2, p.thickness / 2]
         plank.mass = p.mass
