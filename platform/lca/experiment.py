@@ -75,7 +75,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("file", type=Path)
     parser.add_argument("--dry-run", action="store_true", help="print the plan and its cost")
     parser.add_argument("overrides", nargs="*")
-    args = parser.parse_args(argv)
+    args = parser.parse_intermixed_args(argv)
     spec = load_experiment(args.file)
     runs_root = next(
         (o.split("=", 1)[1] for o in args.overrides if o.startswith("runs_root=")),

@@ -310,6 +310,7 @@ class HingedPlankConfig:
     tip_deg: float = 12.0  # hinge range: the plank tips this far either way
     mass: float = 6.0  # kg
     damping: float = 2.0  # N m s / rad
+    gap: float = 0.05  # m between the ledge wall and the plank's near end
 
 
 @dataclass

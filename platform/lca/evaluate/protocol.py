@@ -9,6 +9,8 @@ first missing round and never counts a round twice.
 from __future__ import annotations
 
 import copy
+import json
+import shutil
 import time
 import zlib
 from pathlib import Path
@@ -105,6 +107,7 @@ def evaluate_run(run_dir: Path, cfg: DictConfig, log=print) -> pd.DataFrame:
     total = int(cfg.scale.max_iterations)
     perception = curriculum.perception_on(cfg.curriculum, total - 1, total)
     out_dir = run_dir / "eval"
+    _discard_stale_rounds(out_dir, ev, log)
     for cell in ev.cells:
         name = cell_name(cell)
         todo = [e for e in range(ev.episodes) if not (out_dir / name / f"episode_{e}.csv").exists()]
@@ -128,6 +131,17 @@ def evaluate_run(run_dir: Path, cfg: DictConfig, log=print) -> pd.DataFrame:
                     f"success {frame['success'].mean():.1f} % ({rate:,.0f} steps/s)"
                 )
     return collect_episodes(run_dir, cfg)
+
+
+def _discard_stale_rounds(out_dir: Path, ev, log) -> None:
+    """Finished rounds are reused only under the same protocol; otherwise start afresh."""
+    settings = json.dumps(OmegaConf.to_container(ev, resolve=True), sort_keys=True)
+    stamp = out_dir / "protocol.json"
+    if out_dir.exists() and (not stamp.exists() or stamp.read_text() != settings):
+        if log:
+            log(f"[lca] eval settings changed: discarding the rounds in {out_dir}")
+        shutil.rmtree(out_dir)
+    atomic_write(stamp, settings)
 
 
 def collect_episodes(run_dir: Path, cfg: DictConfig) -> pd.DataFrame:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import html
 import os
+import re
 from pathlib import Path
 
 import pandas as pd
@@ -80,7 +81,8 @@ def sim_table_html(text: pd.DataFrame, best: pd.DataFrame) -> str:
     classes = best.replace({True: "best", False: ""})
     classes.columns = plain.columns
     styled = plain.style.set_td_classes(classes)
-    return styled.set_table_attributes('id="sim-table"').to_html()
+    # Styler names its table T_<uuid>; give it the stable id the page links to
+    return re.sub(r'<table id="T_[^"]*"', '<table id="sim-table"', styled.to_html(), count=1)
 
 
 def hardware_section(table: pd.DataFrame) -> str:

@@ -12,6 +12,18 @@ TERRAINS = {"stairs": "Stairs", "uneven": "Uneven Terrain"}
 DIFFICULTIES = {"medium": "Medium difficulty", "hard": "Hard difficulty"}
 LOWER_IS_BETTER = {"contacts_per_step", "track_cm_s"}
 RESAMPLES, CONFIDENCE, SEED = 2000, 0.95, 0
+CLAIM_COLUMNS = [
+    "two_stage",
+    "one_stage",
+    "seed",
+    "terrain",
+    "difficulty",
+    "metric",
+    "diff",
+    "ci_low",
+    "ci_high",
+    "n_units",
+]
 
 
 def pooled_episodes(runs: list[RunRecord]) -> pd.DataFrame:
@@ -158,4 +170,4 @@ def claim_table(runs: list[RunRecord]) -> pd.DataFrame:
                         **diff,
                     }
                 )
-    return pd.DataFrame(rows)
+    return pd.DataFrame(rows, columns=CLAIM_COLUMNS)

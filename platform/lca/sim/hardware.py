@@ -81,7 +81,7 @@ def hinged_ledge(cfg: HardwareConfig) -> HardwareTask:
     p = cfg.plank
     plank_top = p.pivot_height + p.thickness / 2
     heights = _platform(cfg, plank_top + cfg.ledge_drop)
-    centre_x = cfg.approach + p.length / 2
+    centre_x = cfg.approach + p.gap + p.length / 2
     support_half = (p.pivot_height - p.thickness / 2 - 0.01) / 2
 
     def decorate(spec: mujoco.MjSpec) -> None:
@@ -97,7 +97,7 @@ def hinged_ledge(cfg: HardwareConfig) -> HardwareTask:
         plank.size = [p.length / 2, p.width / 2, p.thickness / 2]
         plank.mass = p.mass
 
-    goal = cfg.approach + p.length + cfg.goal_past
+    goal = cfg.approach + p.gap + p.length + cfg.goal_past
     return HardwareTask(
         "hinged_ledge", _terrain("hinged_ledge", heights, cfg.resolution), goal, decorate
     )

@@ -300,7 +300,8 @@ class LocomotionEnv(VecEnv):
     def _camera_map(self, state: RobotState) -> np.ndarray:
         """The latest deployment map: cameras fire at `rate_hz`; between frames the policy
         reads the last map (a reset env gets a fresh frame at once)."""
-        frame = np.floor(self._episode_steps * self.dt * self.perception_cfg.rate_hz)
+        # the epsilon keeps t = k / rate on frame k despite float rounding (205 * 0.02 * 30)
+        frame = np.floor(self._episode_steps * self.dt * self.perception_cfg.rate_hz + 1e-9)
         due = frame != self._camera_frame
         if due.any():
             points, valid = self.cameras.capture()

@@ -1,0 +1,161 @@
+"""Builders shared by the report-layer tests.
+
+`build_fixture_store` writes a small run store by hand: one folder per run with the
+config.yaml a real run would hold (composed from `policy=<name> seed=<s>`), a
+provenance.json, a train_curve.csv and a results.parquet of hand-made per-episode rows.
+What goes in is declared in fixtures/runs.yaml (runs) and fixtures/cells.csv (per run and
+cell: failed episodes, mean contacts/step and mean tracking error), so every number in the
+report can be worked out by hand. Golden outputs live in golden/; regenerate them with
+`LCA_UPDATE_GOLDEN=1 python -m pytest tests/report/test_golden.py` and inspect the diff.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from omegaconf import OmegaConf
+
+from lca.config import compose
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parents[1]
+FIXTURES = HERE / "fixtures"
+GOLDEN = HERE / "golden"
+UPDATE_GOLDEN = os.environ.get("LCA_UPDATE_GOLDEN") == "1"
+
+# Per-unit offsets around a cell's mean (they sum to zero, so the unit mean of a cell is the
+# value in cells.csv exactly) and per-episode offsets within a unit (also summing to zero).
+CONTACT_UNIT = [-0.15, -0.05, 0.05, 0.15]
+CONTACT_EPISODE = [-0.02, 0.02]
+TRACK_UNIT = [-1.2, -0.4, 0.4, 1.2]
+TRACK_EPISODE = [-0.1, 0.1]
+CURVE_ITERATIONS = 20
+NOT_A_RUN = "notes"  # a folder of the store that is not a run directory
+
+
+def fixture_spec() -> dict:
+    return OmegaConf.to_container(OmegaConf.load(FIXTURES / "runs.yaml"))
+
+
+def fixture_cells() -> pd.DataFrame:
+    return pd.read_csv(FIXTURES / "cells.csv")
+
+
+def cell_episodes(failures: int, contacts: float, track: float, units: int, episodes: int):
+    """Per-episode rows of one cell: the first `failures` rounds in (episode, unit) order fail,
+    so failures spread over units before a unit fails twice."""
+    rows = []
+    order = [(e, u) for e in range(episodes) for u in range(units)]
+    failed = set(order[:failures])
+    for u in range(units):
+        for e in range(episodes):
+            ok = (e, u) not in failed
+            rows.append(
+                {
+                    "unit": u,
+                    "episode": e,
+                    "success": 100.0 if ok else 0.0,
+                    "steps": 1000 if ok else 400 + 100 * u,
+                    "contacts_per_step": contacts + CONTACT_UNIT[u] + CONTACT_EPISODE[e],
+                    "track_cm_s": track + TRACK_UNIT[u] + TRACK_EPISODE[e],
+                    "command_x": 0.3 + 0.1 * u,
+                }
+            )
+    return rows
+
+
+def results_frame(folder: str, cells: pd.DataFrame, units: int, episodes: int) -> pd.DataFrame:
+    rows = []
+    for cell in cells[cells.folder == folder].itertuples():
+        for row in cell_episodes(cell.failures, cell.contacts, cell.track, units, episodes):
+            rows.append(
+                {
+                    "run": folder,
+                    "cell_terrain": cell.terrain,
+                    "cell_difficulty": cell.difficulty,
+                    **row,
+                }
+            )
+    return pd.DataFrame(rows)
+
+
+def train_curve(index: int) -> pd.DataFrame:
+    it = np.arange(CURVE_ITERATIONS)
+    reward = 10.0 * (1.0 - np.exp(-it / 5.0)) + index + 0.3 * np.sin(it)
+    reward[0] = np.nan  # no finished episode yet, as in a real run's first iteration
+    return pd.DataFrame(
+        {
+            "iteration": it,
+            "env_steps": (it + 1) * 8 * 24,
+            "stage": ["blind"] * (CURVE_ITERATIONS // 2) + ["perception"] * (CURVE_ITERATIONS // 2),
+            "mean_reward": reward,
+        }
+    )
+
+
+def build_fixture_store(root: Path) -> Path:
+    """The hand-made run store under `root` (created); returns `root`."""
+    spec, cells = fixture_spec(), fixture_cells()
+    root.mkdir(parents=True, exist_ok=True)
+    for index, run in enumerate(spec["runs"]):
+        path = root / run["folder"]
+        path.mkdir()
+        overrides = [f"policy={run['policy']}", f"seed={run['seed']}"]
+        cfg = compose(overrides)
+        (path / "config.yaml").write_text(OmegaConf.to_yaml(cfg, resolve=True))
+        provenance = {
+            "overrides": overrides,
+            "choices": {"policy": run["policy"]},
+            "seed": run["seed"],
+            "git": {"commit": run["commit"], "dirty": run["dirty"]},
+        }
+        (path / "provenance.json").write_text(json.dumps(provenance, indent=2))
+        train_curve(index).to_csv(path / "train_curve.csv", index=False)
+        if run.get("results", True):
+            frame = results_frame(run["folder"], cells, spec["units"], spec["episodes"])
+            frame.to_parquet(path / "results.parquet", index=False)
+    (root / NOT_A_RUN).mkdir()
+    (root / NOT_A_RUN / "README.txt").write_text("not a run directory\n")
+    return root
+
+
+def cell_units(frame: pd.DataFrame, terrain: str, difficulty: str, metric: str) -> pd.Series:
+    """Per-unit means of `metric` in one cell of a results frame, computed here from scratch."""
+    cell = frame[(frame.cell_terrain == terrain) & (frame.cell_difficulty == difficulty)]
+    return cell.groupby("unit")[metric].mean()
+
+
+def check_golden(produced: Path, name: str) -> None:
+    """`produced` must equal golden/<name> byte for byte (LCA_UPDATE_GOLDEN=1 rewrites it)."""
+    golden = GOLDEN / name
+    if UPDATE_GOLDEN:
+        golden.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(produced, golden)
+    assert golden.is_file(), f"missing {golden}; generate it with LCA_UPDATE_GOLDEN=1"
+    assert produced.read_text() == golden.read_text(), f"{produced} differs from {golden}"
+
+
+def cli_env() -> dict[str, str]:
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("WANDB_", "HYDRA_"))}
+    env["PYTHONUNBUFFERED"] = "1"
+    return env
+
+
+def run_python(*args: str, cwd: Path, timeout: float = 120) -> subprocess.CompletedProcess:
+    """`python ARGS` from `cwd`, output captured."""
+    return subprocess.run(
+        [sys.executable, *args],
+        cwd=cwd,
+        env=cli_env(),
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        check=False,
+    )

@@ -1,0 +1,82 @@
+"""`python -m lca.experiment experiments/paper_sim.yaml --dry-run`: the paper's plan and cost."""
+
+from __future__ import annotations
+
+import re
+from itertools import product
+
+import pytest
+from omegaconf import OmegaConf
+
+from lca.config import compose
+
+from .helpers import REPO, run_python
+
+PAPER_SIM = REPO / "experiments" / "paper_sim.yaml"
+POLICIES = ["blind", "one_mlp", "two_mlp", "one_lstm", "two_lstm", "one_cnn", "two_cnn"]
+SEEDS = [0, 1, 2]
+
+
+def _dry_run(*args: str):
+    out = run_python("-m", "lca.experiment", *args, cwd=REPO, timeout=60)
+    assert out.returncode == 0, out.stdout + out.stderr
+    return out.stdout
+
+
+def _per_run_steps(stdout: str) -> tuple[int, int]:
+    match = re.search(r"per run: ([\d,]+) training \+ ([\d,]+) evaluation env steps", stdout)
+    assert match, stdout
+    return tuple(int(g.replace(",", "")) for g in match.groups())
+
+
+def _expected_steps(*overrides: str) -> tuple[int, int]:
+    cfg = compose(["policy=blind", *overrides])
+    train = cfg.scale.max_iterations * cfg.algo.num_steps_per_env * cfg.task.num_envs
+    ev = cfg.eval
+    return train, len(ev.cells) * ev.units * ev.episodes * ev.steps
+
+
+def test_experiment_file() -> None:
+    spec = OmegaConf.to_container(OmegaConf.load(PAPER_SIM))
+    assert spec["policies"] == POLICIES and spec["seeds"] == SEEDS
+    for policy in POLICIES:
+        assert (REPO / "conf" / "policy" / f"{policy}.yaml").is_file(), policy
+
+
+@pytest.fixture(scope="module")
+def paper_plan() -> str:
+    return _dry_run(str(PAPER_SIM), "--dry-run")
+
+
+def test_dry_run_plans_21_runs(paper_plan: str) -> None:
+    planned = re.findall(r"^  policy=(\w+) seed=(\d+) (.*)$", paper_plan, flags=re.M)
+    assert [(p, int(s)) for p, s, _ in planned] == list(product(POLICIES, SEEDS))
+    assert all(rest.split() == ["scale=paper"] for _, _, rest in planned)
+    assert "21 runs into runs/paper_sim/ with launcher 'local'" in paper_plan
+    command = paper_plan.split("command: ", 1)[1]
+    assert f"policy={','.join(POLICIES)}" in command and "seed=0,1,2" in command
+    assert "runs_root=runs/paper_sim" in command and "hydra/launcher=local" in command
+
+
+def test_dry_run_paper_cost(paper_plan: str) -> None:
+    train, evaluation = _per_run_steps(paper_plan)
+    assert (train, evaluation) == _expected_steps("scale=paper")
+    # the paper's protocol: 4 cells x 500 units x 3 episodes x 1000 steps
+    assert evaluation == 4 * 500 * 3 * 1000
+    assert train == 40000 * 4096 * compose(["scale=paper"]).algo.num_steps_per_env
+
+
+def test_dry_run_overrides_change_the_cost(paper_plan: str) -> None:
+    out = _dry_run("--dry-run", str(PAPER_SIM), "scale=smoke", "runs_root=/tmp/elsewhere")
+    smoke = _per_run_steps(out)
+    assert smoke == _expected_steps("scale=smoke")
+    assert smoke[0] < _per_run_steps(paper_plan)[0] and smoke[1] < _per_run_steps(paper_plan)[1]
+    assert "21 runs into /tmp/elsewhere/ with launcher 'local'" in out
+    assert out.count("scale=smoke") >= 21  # every planned run carries the override
+    assert "runs_root=/tmp/elsewhere" in out.split("command: ", 1)[1]
+
+
+def test_dry_run_documented_argument_order() -> None:
+    out = run_python("-m", "lca.experiment", str(PAPER_SIM), "--dry-run", "scale=smoke", cwd=REPO)
+    assert out.returncode == 0, out.stderr
+    assert _per_run_steps(out.stdout) == _expected_steps("scale=smoke")
