@@ -10,9 +10,10 @@ from __future__ import annotations
 import resource
 from collections.abc import Callable
 
+import numpy as np
 import torch
 
-from lca.bench.timing import median_rate
+from lca.bench.timing import rate
 from lca.config import compose
 from lca.sim.scene import build_scene
 from lca.task.env import LocomotionEnv
@@ -27,33 +28,48 @@ def _max_rss_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
+def _rss_mb() -> float:
+    """Current resident memory of this process (Linux)."""
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * resource.getpagesize() / 2**20
+
+
 def measure(cfg, scene, num_envs: int, threads: int) -> dict:
     cfg.task.num_envs = num_envs
     cfg.sim.num_threads = threads
     torch.manual_seed(0)
-    rss_before = _max_rss_mb()
+    rss_before = _rss_mb()
     env = LocomotionEnv(cfg, scene=scene)
-    rss_after = _max_rss_mb()
+    rss_after = _rss_mb()
     actions = 0.3 * torch.randn(num_envs, env.num_actions)
+    targets = env.default_joint_pos + cfg.task.action_scale * actions.numpy()
+    calls = [0]
 
     def env_chunk() -> int:
         env.step(actions)
         return num_envs
 
     def raw_chunk() -> int:
+        # the same targets, and a reset every second as falls would cause in the env
+        if calls[0] % 50 == 0:
+            env.sim.reset()
+        env.sim.ctrl[:] = targets
         env.sim.step(nstep=env.decimation)
+        calls[0] += 1
         return num_envs
 
-    env_rate = median_rate(env_chunk, REPEATS, MIN_SECONDS)
-    env.sim.reset()
-    raw_rate = median_rate(raw_chunk, REPEATS, MIN_SECONDS)
+    env_rates, raw_rates = [], []
+    for _ in range(REPEATS):  # interleaved, so drifts in machine load hit both alike
+        env_rates.append(rate(env_chunk, MIN_SECONDS))
+        raw_rates.append(rate(raw_chunk, MIN_SECONDS))
+    env_rate, raw_rate = float(np.median(env_rates)), float(np.median(raw_rates))
     return {
         "num_envs": num_envs,
         "threads": threads,
         "steps_per_s": env_rate,
         "raw_steps_per_s": raw_rate,
         "ratio": env_rate / raw_rate,
-        "rss_growth_mb_per_env": max(rss_after - rss_before, 0.0) / num_envs,
+        "memory_mb_per_env": max(rss_after - rss_before, 0.0) / num_envs,
     }
 
 
@@ -84,7 +100,7 @@ def table(result: dict) -> str:
     for r in result["batched"]:
         lines.append(
             f"{r['num_envs']:>8} {r['threads']:>7} {r['steps_per_s']:>10,.0f} "
-            f"{r['raw_steps_per_s']:>10,.0f} {r['ratio']:>6.2f} {r['rss_growth_mb_per_env']:>7.3f}"
+            f"{r['raw_steps_per_s']:>10,.0f} {r['ratio']:>6.2f} {r['memory_mb_per_env']:>7.3f}"
         )
     lines.append(f"peak RSS {result['max_rss_mb']:,.0f} MB")
     hit = [r for r in result["batched"] if r["num_envs"] == 256 and r["threads"] == 2]
