@@ -51,7 +51,13 @@ def assert_finite(obs, reward) -> None:
 # ---- a robot that stands: exact episode bookkeeping ---------------------------------------
 @pytest.fixture(scope="module")
 def stand_env(make_env):
-    return make_env(*STAND, "task.episode_length_s=0.5", "task.action_clip=0.2")
+    # only_positive_rewards off: the logged terms must then add up to the returned reward
+    return make_env(
+        *STAND,
+        "task.episode_length_s=0.5",
+        "task.action_clip=0.2",
+        "task.only_positive_rewards=false",
+    )
 
 
 def test_joint_groups_and_soft_limits(stand_env):

@@ -350,6 +350,19 @@ def test_compute_rewards_multiplies_each_term_by_weight_and_dt():
     np.testing.assert_allclose(total_fast, total / 4)
 
 
+def test_only_positive_rewards_clips_all_but_the_termination_penalty():
+    # env 0: falls with net-negative terms; env 1: net-negative, alive; env 2: net-positive
+    state = make_state(3, base_lin_vel=[[0.0, 0.0, 0.3], [0.0, 0.0, 0.3], [0.0, 0.0, 0.0]])
+    ctx = make_ctx(state, terminated=np.array([True, False, False]))
+    weights = {"alive": 0.15, "lin_vel_z_l2": -2.0, "termination_penalty": -200.0}
+    total, terms = compute_rewards(ctx, weights, dt=0.02, only_positive=True)
+    # env 0: max(0 - 0.0036, 0) - 4; env 1: max(0.003 - 0.0036, 0); env 2: 0.003
+    np.testing.assert_allclose(total, [-4.0, 0.0, 0.003])
+    np.testing.assert_allclose(terms["lin_vel_z_l2"], [-0.0036, -0.0036, 0.0], atol=1e-15)
+    plain, _ = compute_rewards(ctx, weights, dt=0.02)
+    np.testing.assert_allclose(plain, [-4.0036, 0.003 - 0.0036, 0.003])
+
+
 def test_compute_rewards_without_terms_is_zero():
     total, terms = compute_rewards(make_ctx(make_state(3)), {}, dt=0.02)
     assert terms == {}

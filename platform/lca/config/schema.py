@@ -229,6 +229,7 @@ class TaskConfig:
     observations: ObservationConfig = field(default_factory=ObservationConfig)
     commands: CommandConfig = field(default_factory=CommandConfig)
     rewards: dict[str, float] = field(default_factory=dict)
+    only_positive_rewards: bool = True  # clip the step's sum (but termination) at 0
     reward_params: RewardParams = field(default_factory=RewardParams)
     terminations: TerminationConfig = field(default_factory=TerminationConfig)
 

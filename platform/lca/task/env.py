@@ -148,7 +148,9 @@ class LocomotionEnv(VecEnv):
         time_out = (self._episode_steps >= self.max_episode_length) & ~terminated
 
         ctx = self._reward_context(state, terminated)
-        reward, terms = compute_rewards(ctx, self.weights, self.dt)
+        reward, terms = compute_rewards(
+            ctx, self.weights, self.dt, bool(self.task_cfg.only_positive_rewards)
+        )
         for name, value in terms.items():
             self.episode_sums[name] += value
 

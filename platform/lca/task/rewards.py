@@ -196,10 +196,19 @@ REWARD_TERMS: dict[str, Callable[[RewardContext], np.ndarray]] = {
 
 
 def compute_rewards(
-    ctx: RewardContext, weights: dict[str, float], dt: float
+    ctx: RewardContext, weights: dict[str, float], dt: float, only_positive: bool = False
 ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Total reward and each weighted term, (N,). Terms are per second of simulated time,
-    scaled by the policy step `dt`, so weights do not depend on the control rate."""
+    scaled by the policy step `dt`, so weights do not depend on the control rate.
+
+    `only_positive` (legged_gym's `only_positive_rewards`) clips the sum of all terms but the
+    termination penalty at zero before adding that penalty: while a young policy's penalties
+    outweigh its rewards, living longer would otherwise cost more than falling early."""
     terms = {name: weight * REWARD_TERMS[name](ctx) * dt for name, weight in weights.items()}
-    total = np.sum(list(terms.values()), axis=0) if terms else np.zeros(len(ctx.command))
+    total = np.zeros(len(ctx.command))
+    for name, value in terms.items():
+        if not (only_positive and name == "termination_penalty"):
+            total = total + value
+    if only_positive:
+        total = np.clip(total, 0.0, None) + terms.get("termination_penalty", 0.0)
     return total, terms

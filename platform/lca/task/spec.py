@@ -68,6 +68,7 @@ def describe_task(cfg: DictConfig) -> dict:
         "observations": described,
         "actions": {"dim": num_joints, "scale": task.action_scale, "clip": task.action_clip},
         "rewards": {k: float(v) for k, v in task.rewards.items()},
+        "only_positive_rewards": bool(task.only_positive_rewards),
         "reward_params": OmegaConf.to_container(task.reward_params),
         "commands": OmegaConf.to_container(task.commands),
         "terminations": list(TERMINATIONS),
