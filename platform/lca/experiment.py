@@ -18,6 +18,7 @@ from pathlib import Path
 
 from omegaconf import OmegaConf
 
+from lca.cli import split_option
 from lca.config import compose
 
 REPO = Path(__file__).resolve().parents[2]
@@ -77,11 +78,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("overrides", nargs="*")
     args = parser.parse_intermixed_args(argv)
     spec = load_experiment(args.file)
-    runs_root = next(
-        (o.split("=", 1)[1] for o in args.overrides if o.startswith("runs_root=")),
-        spec["runs_root"],
-    )
-    extra = [o for o in args.overrides if not o.startswith("runs_root=")]
+    roots, extra = split_option(args.overrides, "runs_root")
+    runs_root = roots[-1] if roots else spec["runs_root"]
     if args.dry_run:
         plan = list(itertools.product(spec["policies"], spec["seeds"]))
         for policy, seed in plan:

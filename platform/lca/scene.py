@@ -13,6 +13,7 @@ from pathlib import Path
 
 import mujoco
 
+from lca.cli import split_option
 from lca.config import compose
 from lca.sim.scene import build_scene
 
@@ -27,12 +28,11 @@ def export(overrides: list[str], out: Path) -> Path:
 
 def main(argv: list[str] | None = None) -> int:
     args = list(sys.argv[1:] if argv is None else argv)
-    outs = [a for a in args if a.startswith("out=")]
+    outs, overrides = split_option(args, "out")
     if len(outs) != 1:
         print("usage: python -m lca.scene [hydra overrides] out=PATH.mjb", file=sys.stderr)
         return 2
-    out = Path(outs[0].split("=", 1)[1])
-    path = export([a for a in args if not a.startswith("out=")], out)
+    path = export(overrides, Path(outs[0]))
     model = mujoco.MjModel.from_binary_path(str(path))
     print(
         f"wrote {path} ({path.stat().st_size / 1e6:.1f} MB): nq={model.nq} nu={model.nu} "

@@ -6,6 +6,7 @@ length and velocity tracking rise. Writes reports/learning_evidence.{png,md}.
 
 from __future__ import annotations
 
+import shutil
 from collections.abc import Callable
 from pathlib import Path
 
@@ -53,10 +54,7 @@ def plot(curve: pd.DataFrame, out: Path) -> None:
 def run(overrides: list[str], log: Callable[[str], None] | None = print) -> dict:
     cfg = compose([*BASE, *overrides])
     run_path = Path(cfg.runs_root) / "learning_evidence"
-    if (run_path / "checkpoints").exists():
-        import shutil
-
-        shutil.rmtree(run_path)
+    shutil.rmtree(run_path, ignore_errors=True)  # always a fresh run
     train_run(cfg, RunDir(run_path))
     return summarise(run_path, [*BASE, *overrides])
 

@@ -1,6 +1,6 @@
 """Structured Hydra configs: schema dataclasses, validation and composition."""
 
-from lca.config.compose import ConfigError, compose, conf_dir, validate
+from lca.config.compose import ConfigError, compose, conf_dir, load_option, validate
 from lca.config.runtime import register_resolvers, resolve_device, set_torch_threads
 from lca.config.schema import LcaConfig
 
@@ -11,6 +11,7 @@ __all__ = [
     "LcaConfig",
     "compose",
     "conf_dir",
+    "load_option",
     "resolve_device",
     "set_torch_threads",
     "validate",

@@ -46,6 +46,17 @@ def validate(cfg: DictConfig) -> None:
             check()
 
 
+def load_option(group: str, name: str) -> DictConfig:
+    """One option of a config group (conf/<group>/<name>.yaml) checked against its schema.
+    Unlike `compose`, this also works inside a running Hydra app."""
+    path = conf_dir() / group / f"{name}.yaml"
+    if not path.exists():
+        options = sorted(p.stem for p in path.parent.glob("*.yaml"))
+        raise ConfigError(f"{group}: unknown option '{name}'; allowed: {options}")
+    typed = OmegaConf.structured(schema.LcaConfig)[group]
+    return OmegaConf.merge(typed, OmegaConf.load(path))
+
+
 def compose(overrides: list[str] | None = None, config_name: str = "config") -> DictConfig:
     """Compose `conf/config.yaml` with Hydra overrides, then validate it."""
     schema.register()

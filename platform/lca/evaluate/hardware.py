@@ -9,41 +9,28 @@ deployment perception pipeline (depth cameras -> filtered 11 x 11 map).
 
 from __future__ import annotations
 
-import copy
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import torch
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig
 
-from lca.config import conf_dir, schema
+from lca.config import load_option
 from lca.evaluate.policy import final_checkpoint, load_policy
+from lca.evaluate.protocol import trial_config
 from lca.learn import curriculum
 from lca.learn.rundir import atomic_write
 from lca.sim.hardware import HardwareTask, build_task
 from lca.task.env import LocomotionEnv
 
 
-def deployment_perception() -> DictConfig:
-    loaded = OmegaConf.load(conf_dir() / "perception" / "deployment.yaml")
-    return OmegaConf.merge(OmegaConf.structured(schema.PerceptionConfig), loaded)
-
-
 def task_config(cfg: DictConfig) -> DictConfig:
-    c = copy.deepcopy(cfg)
     hw = cfg.hardware
-    c.task.num_envs = hw.trials
-    c.task.episode_length_s = hw.time_limit_s
-    c.task.randomization.enabled = False
+    c = trial_config(cfg, hw.trials, hw.time_limit_s, [hw.command_x, hw.command_x])
     c.task.reset.yaw_range = 0.0  # facing the task
     c.task.reset.base_xy_noise = 0.0
-    c.task.commands.lin_vel_x = [hw.command_x, hw.command_x]
-    c.task.commands.lin_vel_y = [0.0, 0.0]
-    c.task.commands.ang_vel_z = [0.0, 0.0]
-    c.task.commands.standing_fraction = 0.0
-    c.task.commands.resample_time_s = 2 * hw.time_limit_s
-    c.perception = deployment_perception()
+    c.perception = load_option("perception", "deployment")
     return c
 
 

@@ -85,18 +85,23 @@ def describe(values: np.ndarray, resamples: int, confidence: float, seed: int) -
     }
 
 
-def summarize(episodes: pd.DataFrame, resamples: int, confidence: float, seed: int) -> pd.DataFrame:
-    """One row per cell and metric: mean, se, ci_low, ci_high over units."""
+def summarize(
+    episodes: pd.DataFrame,
+    resamples: int,
+    confidence: float,
+    seed: int,
+    by: list[str] = CELL_KEYS,
+) -> pd.DataFrame:
+    """One row per group (a cell by default) and metric: mean, se, ci_low, ci_high over units."""
     rows = []
-    for (terrain, difficulty), cell in episodes.groupby(CELL_KEYS, sort=True):
+    for key, group in episodes.groupby(by, sort=True):
         for metric in METRICS:
-            row = describe(unit_values(cell, metric).to_numpy(), resamples, confidence, seed)
+            row = describe(unit_values(group, metric).to_numpy(), resamples, confidence, seed)
             rows.append(
                 {
-                    "cell_terrain": terrain,
-                    "cell_difficulty": difficulty,
+                    **dict(zip(by, key, strict=True)),
                     "metric": metric,
-                    "n_episodes": len(cell),
+                    "n_episodes": len(group),
                     **row,
                 }
             )

@@ -20,7 +20,7 @@ import pandas as pd
 import torch
 from omegaconf import DictConfig, OmegaConf
 
-from lca.config import conf_dir, schema
+from lca.config import load_option, schema
 from lca.evaluate.metrics import episode_metrics
 from lca.evaluate.policy import final_checkpoint, load_policy
 from lca.learn import curriculum
@@ -46,28 +46,37 @@ def round_seed(base: int, cell, episode: int) -> int:
 
 
 def difficulty_config(name: str) -> DictConfig:
-    """A difficulty group option, read from conf/ (works inside a running Hydra app too)."""
-    loaded = OmegaConf.load(conf_dir() / "difficulty" / f"{name}.yaml")
-    return OmegaConf.merge(OmegaConf.structured(schema.DifficultyConfig), loaded)
+    return load_option("difficulty", name)
+
+
+def trial_config(
+    cfg: DictConfig, num_envs: int, episode_s: float, forward: list[float]
+) -> DictConfig:
+    """A copy of a run's config for testing it: `num_envs` robots, episodes of `episode_s`,
+    forward-only commands in `forward` (m/s), nominal friction and mass, no pushes."""
+    c = copy.deepcopy(cfg)
+    c.task.num_envs = num_envs
+    c.task.episode_length_s = episode_s
+    c.task.randomization.enabled = False
+    commands = c.task.commands
+    commands.lin_vel_x = list(forward)
+    commands.lin_vel_y = [0.0, 0.0]
+    commands.ang_vel_z = [0.0, 0.0]
+    commands.standing_fraction = 0.0
+    commands.resample_time_s = 2 * episode_s
+    return c
 
 
 def cell_config(cfg: DictConfig, cell) -> DictConfig:
     """The run's config turned into the evaluation setting of one cell."""
-    c = copy.deepcopy(cfg)
     ev = cfg.eval
+    episode_s = ev.steps * cfg.sim.timestep * cfg.sim.decimation
+    c = trial_config(cfg, ev.units, episode_s, ev.command_x)
     mixture = {t: 0.0 for t in schema.TERRAIN_TYPES} | CELL_MIXTURES[cell.terrain]
     for kind, weight in mixture.items():
         setattr(c.terrain.mixture, kind, weight)
     c.terrain.name = cell.terrain
     c.difficulty = difficulty_config(cell.difficulty)
-    c.task.num_envs = ev.units
-    c.task.episode_length_s = ev.steps * cfg.sim.timestep * cfg.sim.decimation
-    c.task.randomization.enabled = False  # nominal friction and mass, no pushes
-    c.task.commands.lin_vel_x = list(ev.command_x)
-    c.task.commands.lin_vel_y = [0.0, 0.0]
-    c.task.commands.ang_vel_z = [0.0, 0.0]
-    c.task.commands.standing_fraction = 0.0
-    c.task.commands.resample_time_s = 2 * c.task.episode_length_s
     return c
 
 

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import mujoco
 
+from lca.cli import split_option
 from lca.config import compose
 from lca.sim.hardware import TASKS, build_task
 
@@ -16,10 +17,10 @@ DEFAULT_OUT = Path(__file__).resolve().parents[3] / "assets" / "hardware"
 
 def main(argv: list[str] | None = None) -> int:
     args = list(sys.argv[1:] if argv is None else argv)
-    outs = [a.split("=", 1)[1] for a in args if a.startswith("out=")]
+    outs, overrides = split_option(args, "out")
     out = Path(outs[0]) if outs else DEFAULT_OUT
     out.mkdir(parents=True, exist_ok=True)
-    cfg = compose([a for a in args if not a.startswith("out=")])
+    cfg = compose(overrides)
     for name in TASKS:
         _, scene = build_task(cfg, name)
         path = out / f"{name}.mjb"

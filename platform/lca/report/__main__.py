@@ -5,13 +5,14 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from lca.cli import split_option
 from lca.report.build import build_report
 
 
 def main(argv: list[str] | None = None) -> int:
     args = list(sys.argv[1:] if argv is None else argv)
-    outs = [a.split("=", 1)[1] for a in args if a.startswith("out=")]
-    paths = [Path(a) for a in args if not a.startswith("out=")]
+    outs, rest = split_option(args, "out")
+    paths = [Path(a) for a in rest]
     if not paths:
         print("usage: python -m lca.report <sweep dir | run dirs...> [out=DIR]", file=sys.stderr)
         return 2

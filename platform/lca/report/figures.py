@@ -8,7 +8,6 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from lca.report.collect import RunRecord, row_key  # noqa: E402
@@ -56,6 +55,3 @@ def plot_rewards(runs: list[RunRecord], out_stem: Path) -> list[Path]:
         fig.savefig(path, dpi=150)
     plt.close(fig)
     return paths
-
-
-__all__ = ["plot_rewards", "reward_curves", "np"]

@@ -5,7 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from lca.evaluate.metrics import METRICS, describe, paired_difference, unit_values
+from lca.evaluate.metrics import (
+    CELL_KEYS,
+    METRICS,
+    paired_difference,
+    summarize,
+    unit_values,
+)
 from lca.report.collect import RunRecord, row_key
 
 TERRAINS = {"stairs": "Stairs", "uneven": "Uneven Terrain"}
@@ -42,25 +48,16 @@ def pooled_episodes(runs: list[RunRecord]) -> pd.DataFrame:
 
 def long_table(episodes: pd.DataFrame) -> pd.DataFrame:
     """One row per policy x cell x metric: mean, se, CI over all units of all seeds."""
-    rows = []
-    keys = ["policy", "cell_terrain", "cell_difficulty"]
-    for (policy, terrain, difficulty), cell in episodes.groupby(keys, sort=False):
-        for metric in METRICS:
-            stats = describe(unit_values(cell, metric).to_numpy(), RESAMPLES, CONFIDENCE, SEED)
-            rows.append(
-                {
-                    "policy": policy,
-                    "terrain": terrain,
-                    "difficulty": difficulty,
-                    "metric": metric,
-                    "n_seeds": cell["seed"].nunique(),
-                    **stats,
-                }
-            )
-    table = pd.DataFrame(rows)
+    keys = ["policy", *CELL_KEYS]
+    table = summarize(episodes, RESAMPLES, CONFIDENCE, SEED, by=keys)
     if table.empty:
         return table
-    order = table["policy"].map(lambda p: row_key(p))
+    seeds = episodes.groupby(keys)["seed"].nunique()
+    table.insert(4, "n_seeds", [seeds[k] for k in table[keys].itertuples(index=False)])
+    table = table.drop(columns="n_episodes").rename(
+        columns={"cell_terrain": "terrain", "cell_difficulty": "difficulty"}
+    )
+    order = table["policy"].map(row_key)
     return table.assign(_o=order).sort_values(["_o", "difficulty", "terrain"]).drop(columns="_o")
 
 

@@ -94,29 +94,37 @@ class ContactAccumulator:
             np.maximum(self.leg_force[:, i], force, out=self.leg_force[:, i])
 
 
-def read_state(sim: BatchedSim, contacts: ContactAccumulator) -> RobotState:
+def read_state(
+    sim: BatchedSim, contacts: ContactAccumulator, ids: np.ndarray | None = None
+) -> RobotState:
+    """The state of every env, or only of the rows `ids` (e.g. the envs just reset)."""
+    rows = slice(None) if ids is None else ids
     height_at = sim.scene.terrain.height_at
-    qpos, qvel = sim.qpos, sim.qvel
-    base_pos = qpos[:, :3].copy()
-    foot_pos = np.stack([sim.sensor(f"{s}_foot_pos") for s in g1.FEET], 1).copy()
-    foot_quat = np.stack([sim.sensor(f"{s}_foot_quat") for s in g1.FEET], 1)
+
+    def sensor(name: str) -> np.ndarray:
+        return sim.sensor(name)[rows]  # fancy indexing copies; a slice does not
+
+    qpos, qvel = sim.qpos[rows], sim.qvel[rows]
+    base_pos = np.array(qpos[:, :3])
+    foot_pos = np.stack([sensor(f"{s}_foot_pos") for s in g1.FEET], 1)
+    foot_quat = np.stack([sensor(f"{s}_foot_quat") for s in g1.FEET], 1)
     return RobotState(
         base_pos=base_pos,
-        base_quat=qpos[:, 3:7].copy(),
-        base_lin_vel=sim.sensor("imu_lin_vel").copy(),
-        base_lin_vel_world=sim.sensor("base_lin_vel_world").copy(),
-        base_ang_vel=sim.sensor("imu_ang_vel").copy(),
-        projected_gravity=-sim.sensor("imu_up"),
+        base_quat=np.array(qpos[:, 3:7]),
+        base_lin_vel=np.array(sensor("imu_lin_vel")),
+        base_lin_vel_world=np.array(sensor("base_lin_vel_world")),
+        base_ang_vel=np.array(sensor("imu_ang_vel")),
+        projected_gravity=-sensor("imu_up"),
         base_height=base_pos[:, 2] - height_at(base_pos[:, 0], base_pos[:, 1]),
-        joint_pos=qpos[:, sim.joint_qpos].copy(),
-        joint_vel=qvel[:, sim.joint_dof].copy(),
-        joint_acc=sim.qacc[:, sim.joint_dof].copy(),
-        torque=sim.actuator_force.copy(),
+        joint_pos=np.array(qpos[:, sim.joint_qpos]),
+        joint_vel=np.array(qvel[:, sim.joint_dof]),
+        joint_acc=np.array(sim.qacc[rows][:, sim.joint_dof]),
+        torque=np.array(sim.actuator_force[rows]),
         foot_pos=foot_pos,
-        foot_vel=np.stack([sim.sensor(f"{s}_foot_lin_vel") for s in g1.FEET], 1).copy(),
+        foot_vel=np.stack([sensor(f"{s}_foot_lin_vel") for s in g1.FEET], 1),
         foot_pitch=pitch_of(foot_quat),
         foot_height=foot_pos[..., 2] - height_at(foot_pos[..., 0], foot_pos[..., 1]),
-        foot_force=contacts.foot_force.copy(),
-        foot_lateral_force=contacts.foot_lateral.copy(),
-        leg_contact_force=contacts.leg_force.copy(),
+        foot_force=np.array(contacts.foot_force[rows]),
+        foot_lateral_force=np.array(contacts.foot_lateral[rows]),
+        leg_contact_force=np.array(contacts.leg_force[rows]),
     )
