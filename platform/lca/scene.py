@@ -34,9 +34,9 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     path = export(overrides, Path(outs[0]))
     model = mujoco.MjModel.from_binary_path(str(path))
+    ground = f"hfield {model.hfield_nrow[0]}x{model.hfield_ncol[0]}" if model.nhfield else "plane"
     print(
-        f"wrote {path} ({path.stat().st_size / 1e6:.1f} MB): nq={model.nq} nu={model.nu} "
-        f"hfield {model.hfield_nrow[0]}x{model.hfield_ncol[0]}"
+        f"wrote {path} ({path.stat().st_size / 1e6:.1f} MB): nq={model.nq} nu={model.nu} {ground}"
     )
     return 0
 

@@ -52,3 +52,25 @@ def test_update_resamples_after_the_resample_time():
     for _ in range(2):  # 0.10 s (+ one step of float round-off)
         cmd.update()
     assert (cmd.value != first).all()
+
+
+def test_speed_floor_scales_slow_commands_up_and_keeps_their_direction():
+    cfg = CommandConfig()
+    n = 20000
+    free = VelocityCommand(cfg, n, dt=0.02, rng=np.random.default_rng(1))
+    floored = VelocityCommand(cfg, n, dt=0.02, rng=np.random.default_rng(1))
+    floored.min_speed = 0.3
+    free.resample(np.arange(n))
+    floored.resample(np.arange(n))
+    moving = ~floored.standing
+    speed = np.linalg.norm(floored.value[:, :2], axis=1)
+    assert speed[moving].min() >= 0.3 - 1e-12
+    # the same draws: fast commands untouched, slow ones stretched along their direction
+    fast = np.linalg.norm(free.value[:, :2], axis=1) >= 0.3
+    np.testing.assert_array_equal(floored.value[fast], free.value[fast])
+    slow = moving & ~fast & (np.linalg.norm(free.value[:, :2], axis=1) > 0)
+    assert slow.sum() > 1000
+    cross = np.cross(floored.value[slow, :2], free.value[slow, :2])
+    np.testing.assert_allclose(cross, 0.0, atol=1e-12)
+    np.testing.assert_array_equal(floored.value[:, 2], free.value[:, 2])  # yaw rates kept
+    assert floored.standing.mean() == pytest.approx(cfg.standing_fraction, abs=0.01)

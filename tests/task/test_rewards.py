@@ -395,3 +395,32 @@ def test_configured_reward_params_equal_the_paper(task_cfg):
     assert p.base_height_target == 0.77
     assert p.flat_feet_k == 25.0
     assert task_cfg.commands.standing_epsilon == 5e-3
+
+
+def test_penalty_scale_multiplies_negative_contributions_only():
+    cfg = compose(["scale=smoke"])
+    state = make_state(2, base_height=np.array([0.6, 0.77]))
+    ctx = RewardContext(
+        state=state,
+        command=np.array([[0.5, 0.0, 0.0], [0.0, 0.0, 0.0]]),
+        standing=np.array([False, True]),
+        phase=np.zeros((2, 2)),
+        action=np.ones((2, 29)),
+        last_action=np.zeros((2, 29)),
+        default_joint_pos=np.zeros(29),
+        joint_lower=-np.ones(29),
+        joint_upper=np.ones(29),
+        hip_ids=np.array([1, 2]),
+        arm_ids=np.array([15, 16]),
+        torso_ids=np.array([12]),
+        terminated=np.array([True, False]),
+        params=cfg.task.reward_params,
+    )
+    weights = dict(cfg.task.rewards)
+    full, full_terms = compute_rewards(ctx, weights, 0.02)
+    scaled, terms = compute_rewards(ctx, weights, 0.02, penalty_scale=0.25)
+    for name, value in full_terms.items():
+        expected = np.where(value < 0, 0.25 * value, value)
+        np.testing.assert_allclose(terms[name], expected, err_msg=name)
+    assert (scaled > full).all()
+    assert full_terms["termination_penalty"][0] < 0  # the termination penalty is a penalty

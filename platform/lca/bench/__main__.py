@@ -8,7 +8,7 @@ import json
 import sys
 from pathlib import Path
 
-BENCHMARKS = ("sim", "env", "train", "learn")
+BENCHMARKS = ("sim", "env", "train", "learn", "walk", "levers")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -16,7 +16,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("name", choices=BENCHMARKS)
     parser.add_argument("--json", action="store_true", help="print one JSON object only")
     parser.add_argument("overrides", nargs="*", help="Hydra overrides, e.g. terrain=flat")
-    args = parser.parse_args(argv)
+    args = parser.parse_intermixed_args(argv)
     module = importlib.import_module(f"lca.bench.{args.name}")
     result = module.run(args.overrides, log=None if args.json else print)
     save_dir = Path(__file__).resolve().parents[3] / "reports" / "bench"

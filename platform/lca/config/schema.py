@@ -64,6 +64,10 @@ class RobotConfig:
     # PD gains from armature: kp = I w^2, kd = 2 zeta I w (w = 2 pi f); stiff yet stable at 200 Hz
     natural_frequency_hz: float = 10.0
     damping_ratio: float = 2.0
+    # Explicit gains (joint name regex -> N m/rad, N m s/rad) override the armature rule for
+    # the joints they match, e.g. IsaacLab's G1 gains (conf/robot/g1_isaaclab.yaml).
+    stiffness: dict[str, float] = field(default_factory=dict)
+    damping: dict[str, float] = field(default_factory=dict)
     actuators: dict[str, ActuatorGroup] = field(default_factory=dict)
     home: dict[str, float] = field(default_factory=dict)  # joint name regex -> angle (rad)
     home_base_height: float = 0.0  # 0: computed so the feet rest on the ground
@@ -93,6 +97,9 @@ class RobotConfig:
             )
         _require(self.natural_frequency_hz > 0, "robot.natural_frequency_hz", "must be > 0")
         _require(self.damping_ratio > 0, "robot.damping_ratio", "must be > 0")
+        for key in ("stiffness", "damping"):
+            for pattern, value in getattr(self, key).items():
+                _require(value >= 0, f"robot.{key}.{pattern}", f"must be >= 0, got {value}")
 
 
 @dataclass
@@ -111,7 +118,11 @@ class TerrainConfig:
     cols: int = 4
     tile_size: float = 8.0  # m, square tiles
     resolution: float = 0.01  # m per heightfield sample; 1 cm keeps 0.31/0.23 m treads exact
-    border: float = 1.0  # m of flat ground around the whole grid
+    border: float = 1.0  # m of flat ground around the whole grid (part of the heightfield)
+    # m of flat ground (boxes at height 0) beyond the heightfield on every side: a unit
+    # walking 20 s in any heading never leaves the world
+    apron: float = 30.0
+    flat_as_plane: bool = True  # an all-flat grid is an infinite plane (cheaper contacts)
     platform: float = 1.5  # m, flat square at each tile centre where the robot spawns
     num_steps: int = 8  # steps per pyramid side (stairs_up / stairs_down)
     block_size: float = 0.4  # m, side of a block of the uneven field
@@ -136,6 +147,7 @@ class TerrainConfig:
                 f"{value} m is not a multiple of terrain.resolution={self.resolution}",
             )
         _require(self.platform < self.tile_size, "terrain.platform", "must be < tile_size")
+        _require(self.apron >= 0, "terrain.apron", f"must be >= 0, got {self.apron}")
         _require(self.num_steps >= 1, "terrain.num_steps", f"must be >= 1, got {self.num_steps}")
 
 
@@ -217,11 +229,70 @@ class TerminationConfig:
 
 
 @dataclass
+class RewardCurriculumConfig:
+    """Penalties (every negative reward contribution, the termination penalty included)
+    scaled from `penalty_start` up to the paper's weights as the mean episode length grows.
+    The scale never decreases and is exactly 1 from `deadline` x max_iterations on, so
+    training always ends on the paper's objective."""
+
+    enabled: bool = False
+    penalty_start: float = 0.1  # fraction of the paper's penalty weights at the start
+    # what raises the scale: the mean episode length (length_start -> length_end), or the
+    # iteration (linearly from 0 to the deadline)
+    by: str = "episode_length"
+    length_start: float = 0.2  # ramp starts at this mean episode length (fraction of the max)
+    length_end: float = 0.8  # ... and reaches the paper's weights at this one
+    deadline: float = 0.75  # fraction of max_iterations from which the weights are the paper's
+    only_positive: bool = False  # legged_gym's clip of the step's sum at 0 while scale < 1
+    # terms scaled (their negative contributions); empty: every term, termination included
+    terms: list[str] = field(default_factory=list)
+
+    def check(self) -> None:
+        key = "task.reward_curriculum"
+        _require(0 <= self.penalty_start <= 1, f"{key}.penalty_start", "must be in [0, 1]")
+        _require(
+            0 <= self.length_start < self.length_end <= 1,
+            f"{key}.length_start/length_end",
+            f"need 0 <= start < end <= 1, got {self.length_start}, {self.length_end}",
+        )
+        _require(0 <= self.deadline <= 1, f"{key}.deadline", "must be in [0, 1]")
+        allowed = ("episode_length", "iterations")
+        _require(self.by in allowed, f"{key}.by", f"unknown '{self.by}'; allowed: {allowed}")
+        from lca.task.rewards import REWARD_TERMS  # task layer owns the names
+
+        for name in self.terms:
+            _require(
+                name in REWARD_TERMS,
+                f"{key}.terms",
+                f"unknown reward term '{name}'; allowed: {sorted(REWARD_TERMS)}",
+            )
+
+
+@dataclass
+class CommandCurriculumConfig:
+    """Early commands walk: planar commands slower than a floor are scaled up to it (their
+    direction kept). The floor falls linearly from `min_speed` to 0 at `deadline` x
+    max_iterations, from where commands are the configured distribution."""
+
+    enabled: bool = False
+    min_speed: float = 0.3  # m/s, the floor at the first iteration
+    deadline: float = 0.6  # fraction of max_iterations where the floor reaches 0
+
+    def check(self) -> None:
+        key = "task.command_curriculum"
+        _require(self.min_speed >= 0, f"{key}.min_speed", "must be >= 0")
+        _require(0 <= self.deadline <= 1, f"{key}.deadline", "must be in [0, 1]")
+
+
+@dataclass
 class TaskConfig:
     name: str = "locomotion"
     num_envs: int = 256
     episode_length_s: float = 20.0
     action_scale: float = 0.25  # rad per unit action around the default pose
+    # True: joint j's scale is action_scale * effort_limit_j / kp_j (mjlab's G1 rule), so a
+    # unit action asks for the same fraction of each joint's torque
+    action_scale_by_effort: bool = False
     action_clip: float = 10.0
     perception: bool = True  # False: the actor's heightmap is exactly zero
     reset: ResetConfig = field(default_factory=ResetConfig)
@@ -229,12 +300,16 @@ class TaskConfig:
     observations: ObservationConfig = field(default_factory=ObservationConfig)
     commands: CommandConfig = field(default_factory=CommandConfig)
     rewards: dict[str, float] = field(default_factory=dict)
-    only_positive_rewards: bool = True  # clip the step's sum (but termination) at 0
+    only_positive_rewards: bool = False  # clip the step's sum (but termination) at 0, always
+    reward_curriculum: RewardCurriculumConfig = field(default_factory=RewardCurriculumConfig)
+    command_curriculum: CommandCurriculumConfig = field(default_factory=CommandCurriculumConfig)
     reward_params: RewardParams = field(default_factory=RewardParams)
     terminations: TerminationConfig = field(default_factory=TerminationConfig)
 
     def check(self) -> None:
         _require(self.num_envs >= 1, "task.num_envs", f"must be >= 1, got {self.num_envs}")
+        self.reward_curriculum.check()
+        self.command_curriculum.check()
         _check_range("task.randomization.friction", self.randomization.friction)
         _check_range("task.randomization.added_base_mass", self.randomization.added_base_mass, -1e9)
         _require(self.observations.history >= 1, "task.observations.history", "must be >= 1")
@@ -360,11 +435,23 @@ class ActorConfig:
     activation: str = "elu"
     rnn_hidden_dim: int = 256  # LSTM width before the MLP head (lstm only)
     init_noise_std: float = 1.0
+    # > 0: the action std is capped by a ceiling falling linearly from init_noise_std to this
+    # value at `noise_deadline` x max_iterations (and staying there): explore early, act
+    # precisely once the penalties are the paper's. 0: rsl-rl's free, learned std.
+    final_noise_std: float = 0.0
+    noise_deadline: float = 0.6
 
     def check(self) -> None:
         _require(
             self.kind in ACTOR_KINDS, "actor.kind", f"unknown '{self.kind}'; allowed: {ACTOR_KINDS}"
         )
+        _require(self.init_noise_std > 0, "actor.init_noise_std", "must be > 0")
+        _require(
+            0 <= self.final_noise_std <= self.init_noise_std,
+            "actor.final_noise_std",
+            f"must be in [0, init_noise_std={self.init_noise_std}], got {self.final_noise_std}",
+        )
+        _require(0 <= self.noise_deadline <= 1, "actor.noise_deadline", "must be in [0, 1]")
 
 
 @dataclass
@@ -413,6 +500,8 @@ class AlgoConfig:
     schedule: str = "adaptive"
     desired_kl: float = 0.01
     obs_normalization: bool = True
+    symmetry: bool = False  # rsl-rl symmetry_cfg: every mini-batch also holds its mirror image
+    mirror_loss_coeff: float = 0.0  # > 0 adds rsl-rl's mirror loss (MLP actors only)
 
 
 EVAL_TERRAINS = ("stairs", "uneven", "flat", "stairs_up", "stairs_down", "mixed")
@@ -483,6 +572,9 @@ class LcaConfig:
     seed: int = 0
     device: str = "auto"  # torch device: auto = cuda when available, else cpu
     torch_threads: int = 0  # 0 = torch default
+    # torch threads while collecting rollouts (small policy inferences next to mjbatch's
+    # threads); 0 = the same as for the update
+    collect_threads: int = 0
     runs_root: str = "runs"  # run store: one folder per run, named by its overrides
     force: bool = False  # re-run even when the run directory holds a completed run
     sim: SimConfig = field(default_factory=SimConfig)

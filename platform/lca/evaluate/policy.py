@@ -34,10 +34,21 @@ def final_checkpoint(run_dir: Path) -> Path:
     return finals[-1]
 
 
+def _runner(cfg: DictConfig, env: LocomotionEnv) -> OnPolicyRunner:
+    with contextlib.redirect_stdout(io.StringIO()):
+        return OnPolicyRunner(
+            env, build_train_cfg(cfg, "eval"), log_dir=None, device=resolve_device(cfg.device)
+        )
+
+
+def new_policy(cfg: DictConfig, env: LocomotionEnv):
+    """A freshly initialised actor for `env` in evaluation mode (load weights into it)."""
+    return _runner(cfg, env).get_inference_policy(resolve_device(cfg.device))
+
+
 def load_policy(cfg: DictConfig, env: LocomotionEnv, checkpoint: Path):
     """The deterministic actor of `checkpoint`: `policy(obs)`, `policy.reset(dones)`."""
     device = resolve_device(cfg.device)
-    with contextlib.redirect_stdout(io.StringIO()):
-        runner = OnPolicyRunner(env, build_train_cfg(cfg, "eval"), log_dir=None, device=device)
+    runner = _runner(cfg, env)
     runner.load(str(checkpoint), load_cfg={"actor": True}, strict=True, map_location=device)
     return runner.get_inference_policy(device)

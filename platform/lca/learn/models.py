@@ -68,6 +68,13 @@ class PerceptiveMLPModel(MLPModel):
     def _get_latent_dim(self) -> int:
         return self.obs_dim + self._z_dim
 
+    def get_kl_divergence(self, old_params, new_params) -> torch.Tensor:
+        """PPO's adaptive schedule calls this once per mini-batch; the trainer logs the mean."""
+        kl = super().get_kl_divergence(old_params, new_params)
+        if hasattr(self, "kl_values"):
+            self.kl_values.append(float(kl.mean()))
+        return kl
+
     def _features(self, obs: TensorDict) -> torch.Tensor:
         flat = MLPModel.get_latent(self, obs)
         return torch.cat([flat, self.encoder(obs[self.image_group])], dim=-1)

@@ -12,6 +12,7 @@ ACTOR_CLASSES = {
     "lstm": "lca.learn.models:PerceptiveRNNModel",
 }
 CRITIC_CLASS = "lca.learn.models:PerceptiveMLPModel"
+SYMMETRY_FUNC = "lca.learn.symmetry:augment"
 OBS_GROUPS = {"actor": ["policy", "height"], "critic": ["critic", "critic_height"]}
 
 
@@ -33,6 +34,17 @@ def build_train_cfg(cfg: DictConfig, run_name: str) -> dict:
     algo.pop("name")
     num_steps = algo.pop("num_steps_per_env")
     obs_normalization = algo.pop("obs_normalization")
+    symmetry_cfg = None
+    mirror_loss = algo.pop("mirror_loss_coeff")
+    # rsl-rl's symmetry extension takes feed-forward actors only; recurrent ones train without
+    recurrent = cfg.actor.kind == "lstm"
+    if (algo.pop("symmetry") or mirror_loss > 0) and not recurrent:
+        symmetry_cfg = {
+            "use_data_augmentation": bool(cfg.algo.symmetry),
+            "use_mirror_loss": mirror_loss > 0,
+            "mirror_loss_coeff": mirror_loss,
+            "data_augmentation_func": SYMMETRY_FUNC,
+        }
     actor = {
         "class_name": ACTOR_CLASSES[cfg.actor.kind],
         "hidden_dims": list(cfg.actor.hidden_dims),
@@ -58,7 +70,7 @@ def build_train_cfg(cfg: DictConfig, run_name: str) -> dict:
         "num_steps_per_env": num_steps,
         "save_interval": 10**9,  # checkpoints are written by lca's trainer, not the runner
         "obs_groups": {k: list(v) for k, v in OBS_GROUPS.items()},
-        "algorithm": {"class_name": "PPO", **algo, "rnd_cfg": None, "symmetry_cfg": None},
+        "algorithm": {"class_name": "PPO", **algo, "rnd_cfg": None, "symmetry_cfg": symmetry_cfg},
         "actor": actor,
         "critic": critic,
         "logger": logger_cfg(cfg),

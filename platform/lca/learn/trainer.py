@@ -23,6 +23,9 @@ from rsl_rl.runners import OnPolicyRunner
 
 from lca.config.runtime import resolve_device
 from lca.learn import curriculum
+from lca.learn.command_curriculum import CommandCurriculum
+from lca.learn.exploration import apply_ceiling, noise_ceiling
+from lca.learn.reward_curriculum import RewardCurriculum
 from lca.learn.rundir import RunDir
 from lca.learn.train_cfg import build_train_cfg
 from lca.task.env import LocomotionEnv
@@ -42,6 +45,10 @@ CURVE_FIELDS = (
     "value_loss",
     "surrogate_loss",
     "action_std",
+    "learning_rate",
+    "kl",
+    "penalty_scale",
+    "command_floor",
 )
 
 
@@ -110,12 +117,18 @@ class Trainer:
             self.runner = OnPolicyRunner(self.env, train_cfg, log_dir=log_dir, device=self.device)
         self.alg = self.runner.alg
         self.start = 0
+        infos = None
         latest = run_dir.latest_checkpoint()
         if latest is not None:
-            self.runner.load(str(latest), map_location=self.device)
+            infos = self.runner.load(str(latest), map_location=self.device)
             # rsl-rl stores the index of the last finished iteration
             self.start = self.runner.current_learning_iteration + 1
             print(f"[lca] resuming {run_dir.path.name} at iteration {self.start}/{self.total}")
+        self.rewards = RewardCurriculum(
+            cfg.task.reward_curriculum, self.total, (infos or {}).get("penalty_scale")
+        )
+        self.commands = CommandCurriculum(cfg.task.command_curriculum, self.total)
+        self.stopped_early = False
 
     def perception_on(self, iteration: int) -> bool:
         return curriculum.perception_on(self.cfg.curriculum, iteration, self.total)
@@ -127,7 +140,10 @@ class Trainer:
         tmp = path.with_suffix(".tmp")
         self.runner.save(
             str(tmp),
-            infos={"stage": curriculum.stage_name(self.cfg.curriculum, iteration, self.total)},
+            infos={
+                "stage": curriculum.stage_name(self.cfg.curriculum, iteration, self.total),
+                "penalty_scale": self.rewards.scale,
+            },
         )
         tmp.replace(path)
         return path
@@ -139,7 +155,10 @@ class Trainer:
         with self.run.curve.open(newline="") as f:
             return [r for r in csv.DictReader(f) if int(r["iteration"]) < iteration]
 
-    def train(self) -> dict:
+    def train(self, hook=None) -> dict:
+        """Train to `scale.max_iterations`. `hook(trainer, iteration, row)`, if given, runs
+        after every iteration outside the timed training (its time is not in `wall_s`) and
+        may return True to stop training there."""
         cfg, env, alg = self.cfg, self.env, self.alg
         num_steps = int(cfg.algo.num_steps_per_env)
         stats = EpisodeStats(env.num_envs, env.device)
@@ -156,8 +175,7 @@ class Trainer:
         t_start = time.perf_counter()
         try:
             self.runner.logger.init_logging_writer()
-            self._loop(writer, curve, stats, switch, obs, t_start, num_steps)
-            final = self.total - 1
+            final = self._loop(writer, curve, stats, switch, obs, t_start, num_steps, hook)
             stage = curriculum.stage_name(cfg.curriculum, final, self.total)
             self.save(f"final_{stage}.pt", final)
             self.save("latest.pt", final)
@@ -166,15 +184,29 @@ class Trainer:
             self.runner.logger.stop_logging_writer()  # wandb.finish() even on failure
         return self.last
 
-    def _loop(self, writer, curve, stats, switch, obs, t_start, num_steps) -> None:
+    def _loop(self, writer, curve, stats, switch, obs, t_start, num_steps, hook) -> int:
+        """Returns the index of the last iteration trained."""
         cfg, env, alg = self.cfg, self.env, self.alg
+        paused = 0.0  # seconds spent in the hook, kept out of wall_s
+        wall_before = float(self.last.get("wall_s", 0.0))  # a resumed run's earlier time
+        actor = alg.get_policy()
+        it = self.start - 1
         for it in range(self.start, self.total):
             if it == switch and it > 0 and not self.perception_on(it - 1):
                 self.save(f"stage1_blind_it{it - 1}.pt", it - 1)
             if self.perception_on(it) != env.perception:
                 env.set_perception(self.perception_on(it))
                 obs = env.get_observations().to(self.device)
+            length = self.last.get("mean_episode_length", math.nan)
+            self.rewards.update(it, float(length) / env.max_episode_length)
+            env.set_reward_shaping(self.rewards.scale, self.rewards.only_positive)
+            env.commands.min_speed = self.commands.floor(it)
+            apply_ceiling(actor, noise_ceiling(cfg.actor, it, self.total))
+            actor.kl_values = []
             t0 = time.perf_counter()
+            update_threads = torch.get_num_threads()
+            if cfg.collect_threads > 0:
+                torch.set_num_threads(int(cfg.collect_threads))
             with torch.inference_mode():
                 for _ in range(num_steps):
                     actions = alg.act(obs)
@@ -188,6 +220,7 @@ class Trainer:
                     self.runner.logger.process_env_step(rewards, dones, extras)
                     stats.add(rewards, dones, extras.get("log", {}))
                 alg.compute_returns(obs)
+            torch.set_num_threads(update_threads)
             t1 = time.perf_counter()
             losses = alg.update()
             t2 = time.perf_counter()
@@ -205,18 +238,23 @@ class Trainer:
                     rnd_weight=None,
                 )
             done_its = it + 1 - self.start
-            elapsed = time.perf_counter() - t_start
+            elapsed = time.perf_counter() - t_start - paused
+            kl = getattr(actor, "kl_values", [])
             row = {
                 "iteration": it,
                 "env_steps": (it + 1) * num_steps * env.num_envs,
-                "wall_s": round(elapsed, 3),
+                "wall_s": round(wall_before + elapsed, 3),
                 "stage": "perception" if env.perception else "blind",
                 "steps_per_s": num_steps * env.num_envs / (t2 - t0),
                 "collect_s": t1 - t0,
                 "update_s": t2 - t1,
                 "value_loss": losses.get("value", losses.get("value_function", math.nan)),
                 "surrogate_loss": losses.get("surrogate", math.nan),
-                "action_std": float(alg.get_policy().output_std.detach().mean()),
+                "action_std": float(actor.output_std.detach().mean()),
+                "learning_rate": alg.learning_rate,
+                "kl": float(np.mean(kl)) if kl else math.nan,
+                "penalty_scale": self.rewards.scale,
+                "command_floor": env.commands.min_speed,
                 **stats.summary(),
             }
             writer.writerow(row)
@@ -227,11 +265,20 @@ class Trainer:
                 print(
                     f"[lca] it {it + 1:>5}/{self.total} | {row['steps_per_s']:8,.0f} steps/s | "
                     f"reward {row['mean_reward']:8.2f} | ep len {row['mean_episode_length']:6.1f}"
-                    f" | {row['stage']:<10} | ETA {_fmt_eta(eta)}",
+                    f" | {row['stage']:<10} | penalties x{row['penalty_scale']:.2f}"
+                    f" | lr {row['learning_rate']:.1e} | ETA {_fmt_eta(eta)}",
                     flush=True,
                 )
             if (it + 1) % cfg.scale.checkpoint_interval == 0:
                 self.save("latest.pt", it)
+            if hook is not None:
+                t_hook = time.perf_counter()
+                stop = hook(self, it, row)
+                paused += time.perf_counter() - t_hook
+                if stop:
+                    self.stopped_early = it + 1 < self.total
+                    break
+        return it
 
     def export(self) -> dict[str, Path]:
         self.run.exported.mkdir(parents=True, exist_ok=True)

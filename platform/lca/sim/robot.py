@@ -90,6 +90,10 @@ def actuator_table(cfg: RobotConfig, joint_names: list[str]) -> dict[str, dict[s
         group = cfg.actuators[group_name]
         armature = reflected_inertia(group)
         kp, kd = pd_gains(armature, cfg.natural_frequency_hz, cfg.damping_ratio)
+        if (pattern := _match(dict(cfg.stiffness), joint)) is not None:
+            kp = float(cfg.stiffness[pattern])
+        if (pattern := _match(dict(cfg.damping), joint)) is not None:
+            kd = float(cfg.damping[pattern])
         table[joint] = {
             "armature": armature,
             "kp": kp,

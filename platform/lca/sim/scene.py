@@ -47,9 +47,20 @@ def apply_sim_options(spec: mujoco.MjSpec, cfg: SimConfig) -> None:
     spec.visual.global_.bvactive = int(cfg.bvactive)
 
 
-def add_terrain(spec: mujoco.MjSpec, terrain: Terrain) -> None:
-    """Add `terrain` as an hfield geom; MuJoCo stores heights normalised to [0, 1]."""
+def add_terrain(
+    spec: mujoco.MjSpec, terrain: Terrain, apron: float = 0.0, plane: bool = False
+) -> None:
+    """Add `terrain` as an hfield geom (MuJoCo stores heights normalised to [0, 1]), or, with
+    `plane` (for an all-flat terrain), as an infinite plane at height 0. `apron` > 0 surrounds
+    the hfield with flat ground at height 0 (its border's height) that far on every side."""
     h = terrain.heights
+    rgba = [0.45, 0.5, 0.55, 1.0]
+    collide = {"contype": g1.TERRAIN_CONTYPE, "conaffinity": g1.TERRAIN_CONAFFINITY, "condim": 3}
+    if plane:
+        spec.worldbody.add_geom(
+            name="terrain", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 1], rgba=rgba, **collide
+        )
+        return
     low, span = float(h.min()), float(np.ptp(h))
     span = max(span, 1e-3)  # MuJoCo needs a positive elevation range even for flat ground
     nrow, ncol = h.shape
@@ -67,11 +78,33 @@ def add_terrain(spec: mujoco.MjSpec, terrain: Terrain) -> None:
         type=mujoco.mjtGeom.mjGEOM_HFIELD,
         hfieldname="terrain",
         pos=[cx, cy, low],
-        contype=g1.TERRAIN_CONTYPE,
-        conaffinity=g1.TERRAIN_CONAFFINITY,
-        condim=3,
-        rgba=[0.45, 0.5, 0.55, 1.0],
+        rgba=rgba,
+        **collide,
     )
+    if apron > 0:
+        _add_apron(spec, terrain, apron, rgba, collide)
+
+
+def _add_apron(spec, terrain: Terrain, apron: float, rgba, collide) -> None:
+    """Four boxes, top face at z = 0, framing the heightfield (x strips span the corners)."""
+    (x0, y0), (sx, sy) = terrain.origin, terrain.size
+    depth = HFIELD_BASE_DEPTH
+    for i, (cx, cy, hx, hy) in enumerate(
+        [
+            (x0 - apron / 2, y0 + sy / 2, apron / 2, sy / 2 + apron),
+            (x0 + sx + apron / 2, y0 + sy / 2, apron / 2, sy / 2 + apron),
+            (x0 + sx / 2, y0 - apron / 2, sx / 2, apron / 2),
+            (x0 + sx / 2, y0 + sy + apron / 2, sx / 2, apron / 2),
+        ]
+    ):
+        spec.worldbody.add_geom(
+            name=f"apron{i}",
+            type=mujoco.mjtGeom.mjGEOM_BOX,
+            size=[hx, hy, depth / 2],
+            pos=[cx, cy, -depth / 2],
+            rgba=rgba,
+            **collide,
+        )
 
 
 def standing_base_height(spec_model: mujoco.MjModel, joint_pos: np.ndarray) -> float:
@@ -103,8 +136,15 @@ def build_scene(
     home_joints = g1.home_joint_positions(robot_cfg, joint_names)
     base_height = robot_cfg.home_base_height or standing_base_height(spec.compile(), home_joints)
 
-    terrain = terrain if terrain is not None else generate(cfg.terrain, cfg.difficulty)
-    add_terrain(spec, terrain)
+    generated = terrain is None
+    terrain = generate(cfg.terrain, cfg.difficulty) if generated else terrain
+    # a given terrain (a hardware task) is the whole world; a tile grid gets flat ground around
+    add_terrain(
+        spec,
+        terrain,
+        apron=float(cfg.terrain.apron) if generated else 0.0,
+        plane=generated and cfg.terrain.flat_as_plane and not terrain.heights.any(),
+    )
     if decorate is not None:
         decorate(spec)
     x, y = terrain.tiles[0].centre

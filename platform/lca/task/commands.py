@@ -17,6 +17,7 @@ class VelocityCommand:
         self.rng = rng
         self.value = np.zeros((num_envs, 3))
         self.time_left = np.zeros(num_envs)
+        self.min_speed = 0.0  # the command curriculum's floor on |u_xy| (0: off)
 
     @property
     def standing(self) -> np.ndarray:
@@ -35,6 +36,8 @@ class VelocityCommand:
             ],
             axis=1,
         )
+        if self.min_speed > 0:
+            value[:, :2] = _at_least(value[:, :2], self.min_speed)
         value[self.rng.random(n) < c.standing_fraction] = 0.0
         self.value[ids] = value
         self.time_left[ids] = c.resample_time_s
@@ -42,6 +45,13 @@ class VelocityCommand:
     def update(self) -> None:
         self.time_left -= self.dt
         self.resample(np.flatnonzero(self.time_left <= 0))
+
+
+def _at_least(planar: np.ndarray, floor: float) -> np.ndarray:
+    """Planar commands slower than `floor` scaled up to it, direction kept (+x if none)."""
+    speed = np.linalg.norm(planar, axis=1, keepdims=True)
+    direction = np.where(speed > 0, planar / np.maximum(speed, 1e-12), [1.0, 0.0])
+    return np.where(speed < floor, direction * floor, planar)
 
 
 def gait_phase(episode_time: np.ndarray, period: float) -> np.ndarray:

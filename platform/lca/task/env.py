@@ -53,6 +53,16 @@ def joint_ids(names: list[str], *patterns: str) -> np.ndarray:
     return np.array([i for i, n in enumerate(names) if any(p in n for p in patterns)], dtype=int)
 
 
+def action_scales(model: mujoco.MjModel, task) -> np.ndarray:
+    """(J,) rad per unit action: one scale, or scale * effort limit / kp per joint."""
+    n = model.nu
+    if not task.action_scale_by_effort:
+        return np.full(n, float(task.action_scale))
+    kp = model.actuator_gainprm[:, 0]
+    effort = model.actuator_forcerange[:, 1]
+    return float(task.action_scale) * effort / kp
+
+
 class LocomotionEnv(VecEnv):
     def __init__(self, cfg: DictConfig, scene: Scene | None = None):
         self.cfg = EnvConfig(cfg)  # rsl-rl's loggers call cfg.to_dict()
@@ -70,6 +80,7 @@ class LocomotionEnv(VecEnv):
         names = self.scene.joint_names
         self.num_actions = len(names)
         self.default_joint_pos = self.scene.home_joint_pos.copy()
+        self.action_scale = action_scales(self.scene.model, task)
         self.hip_ids = joint_ids(names, "hip_roll", "hip_yaw")
         self.arm_ids = joint_ids(names, "shoulder", "elbow", "wrist")
         self.torso_ids = joint_ids(names, "waist")
@@ -77,6 +88,10 @@ class LocomotionEnv(VecEnv):
         mid, half = (lower + upper) / 2, (upper - lower) / 2 * task.reward_params.soft_limit_factor
         self.joint_lower, self.joint_upper = mid - half, mid + half
         self.weights = {k: float(v) for k, v in task.rewards.items()}
+        # the reward curriculum's knobs (lca.learn.reward_curriculum); the paper's: 1, False
+        self.penalty_scale = 1.0
+        self.only_positive = bool(task.only_positive_rewards)
+        self.scaled_terms = frozenset(task.reward_curriculum.terms) or None
         self.perception = bool(task.perception)
         self.height_noise = float(cfg.difficulty.height_noise) if task.observations.noise else 0.0
 
@@ -129,7 +144,7 @@ class LocomotionEnv(VecEnv):
         clip = self.task_cfg.action_clip
         self.last_action = self.action
         self.action = np.clip(actions.detach().cpu().numpy().astype(np.float64), -clip, clip)
-        self.sim.ctrl[:] = self.default_joint_pos + self.task_cfg.action_scale * self.action
+        self.sim.ctrl[:] = self.default_joint_pos + self.action_scale * self.action
         bad_before = ~np.isfinite(self.sim.qpos).all(1) | ~np.isfinite(self.sim.qvel).all(1)
         warnings_before = self._bad_state_warnings()
         self.contacts.clear()
@@ -150,7 +165,7 @@ class LocomotionEnv(VecEnv):
 
         ctx = self._reward_context(state, terminated)
         reward, terms = compute_rewards(
-            ctx, self.weights, self.dt, bool(self.task_cfg.only_positive_rewards)
+            ctx, self.weights, self.dt, self.only_positive, self.penalty_scale, self.scaled_terms
         )
         for name, value in terms.items():
             self.episode_sums[name] += value
@@ -166,6 +181,9 @@ class LocomotionEnv(VecEnv):
             extras["log"] = self._episode_log(done_ids, fallen, time_out)
         self.nonfinite_resets += int(broken.sum())
         extras["log"]["Episode_Termination/nonfinite_total"] = float(self.nonfinite_resets)
+        extras["log"]["Curriculum/penalty_scale"] = self.penalty_scale
+        extras["log"]["Curriculum/only_positive"] = float(self.only_positive)
+        extras["log"]["Curriculum/command_floor"] = self.commands.min_speed
         self._reset_envs(done_ids)
         if done_ids.size:
             state = _replace_rows(state, read_state(self.sim, self.contacts, done_ids), done_ids)
@@ -337,6 +355,11 @@ class LocomotionEnv(VecEnv):
         self.critic_history.buffer[:] = 0.0
         self._obs = self._observe(read_state(self.sim, self.contacts))
         return self._obs
+
+    def set_reward_shaping(self, penalty_scale: float, only_positive: bool) -> None:
+        """Reward curriculum: negative contributions x `penalty_scale`; optional clipping."""
+        self.penalty_scale = float(penalty_scale)
+        self.only_positive = bool(only_positive) or bool(self.task_cfg.only_positive_rewards)
 
     def set_perception(self, on: bool) -> None:
         """Curriculum switch: when off the actor's map is exactly zero; the critic keeps its map.

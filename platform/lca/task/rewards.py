@@ -196,15 +196,27 @@ REWARD_TERMS: dict[str, Callable[[RewardContext], np.ndarray]] = {
 
 
 def compute_rewards(
-    ctx: RewardContext, weights: dict[str, float], dt: float, only_positive: bool = False
+    ctx: RewardContext,
+    weights: dict[str, float],
+    dt: float,
+    only_positive: bool = False,
+    penalty_scale: float = 1.0,
+    scaled_terms: frozenset[str] | None = None,
 ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Total reward and each weighted term, (N,). Terms are per second of simulated time,
     scaled by the policy step `dt`, so weights do not depend on the control rate.
 
-    `only_positive` (legged_gym's `only_positive_rewards`) clips the sum of all terms but the
-    termination penalty at zero before adding that penalty: while a young policy's penalties
-    outweigh its rewards, living longer would otherwise cost more than falling early."""
-    terms = {name: weight * REWARD_TERMS[name](ctx) * dt for name, weight in weights.items()}
+    `penalty_scale` multiplies the negative contributions of `scaled_terms` (None: every
+    term) -- the reward curriculum; 1 is the paper's table. `only_positive` (legged_gym's
+    `only_positive_rewards`) clips the sum of all terms but the termination penalty at zero
+    before adding that penalty: while a young policy's penalties outweigh its rewards, living
+    longer would otherwise cost more than falling early."""
+    terms = {}
+    for name, weight in weights.items():
+        value = weight * REWARD_TERMS[name](ctx) * dt
+        if penalty_scale != 1.0 and (scaled_terms is None or name in scaled_terms):
+            value = np.where(value < 0, penalty_scale * value, value)
+        terms[name] = value
     total = np.zeros(len(ctx.command))
     for name, value in terms.items():
         if not (only_positive and name == "termination_penalty"):

@@ -1,0 +1,133 @@
+"""The learning levers, each measured against the same wall-clock budget.
+
+    python -m lca.bench levers [budget_s=1200] [only=a,b] [runs=runs/levers]
+
+Every lever is one run of the time-to-walk benchmark (blind MLP, flat ground, `scale=cpu`)
+with the recipe's defaults changed by the lever's overrides, trained for `budget_s` seconds
+of wall-clock and evaluated in-process with the paper's protocol on a flat cell. A finished
+lever is reused (its run directory holds its result); writes reports/learning_levers.md.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+from lca.bench import walk
+from lca.cli import split_option
+
+# name -> (what it changes, overrides on top of the scale=cpu recipe)
+LEVERS: dict[str, tuple[str, list[str]]] = {
+    "recipe": ("the scale=cpu defaults", []),
+    "before": (
+        "the defaults before the recipe: one action scale 0.25, always only_positive, "
+        "no reward curriculum, no symmetry",
+        [
+            "task.action_scale_by_effort=false",
+            "task.only_positive_rewards=true",
+            "task.reward_curriculum.enabled=false",
+            "algo.symmetry=false",
+        ],
+    ),
+    "no_curriculum": ("paper penalties from the start", ["task.reward_curriculum.enabled=false"]),
+    "only_positive_stage": (
+        "legged_gym's clipping while the curriculum runs",
+        ["task.reward_curriculum.only_positive=true"],
+    ),
+    "isaaclab_gains": (
+        "IsaacLab's G1 gains and one action scale 0.5",
+        ["robot=g1_isaaclab", "task.action_scale_by_effort=false", "task.action_scale=0.5"],
+    ),
+    "one_action_scale": ("one action scale 0.25", ["task.action_scale_by_effort=false"]),
+    "init_noise_0.5": ("initial action std 0.5", ["actor.init_noise_std=0.5"]),
+    "no_symmetry": ("no mirror augmentation", ["algo.symmetry=false"]),
+    "fixed_lr": ("fixed learning rate 3e-4", ["algo.schedule=fixed", "algo.learning_rate=3e-4"]),
+    "envs_512x12": (
+        "512 envs x 12 steps",
+        ["scale.num_envs=512", "task.num_envs=512", "algo.num_steps_per_env=12"],
+    ),
+    "envs_128x48": (
+        "128 envs x 48 steps",
+        ["scale.num_envs=128", "task.num_envs=128", "algo.num_steps_per_env=48"],
+    ),
+    "heightfield_floor": ("flat ground as a heightfield", ["terrain.flat_as_plane=false"]),
+    "small_networks": (
+        "actor and critic {256, 128, 128} (report only)",
+        ["actor.hidden_dims=[256,128,128]"],
+    ),
+}
+
+
+def run(args: list[str], log: Callable[[str], None] | None = print) -> dict:
+    budgets, args = split_option(args, "budget_s")
+    onlys, args = split_option(args, "only")
+    roots, args = split_option(args, "runs")
+    budget = float(budgets[-1]) if budgets else 1200.0
+    root = Path(roots[-1] if roots else "runs/levers")
+    names = onlys[-1].split(",") if onlys else list(LEVERS)
+    unknown = [n for n in names if n not in LEVERS]
+    if unknown:
+        raise SystemExit(f"only: unknown lever(s) {unknown}; allowed: {list(LEVERS)}")
+    results = {}
+    for name in names:
+        what, overrides = LEVERS[name]
+        if log:
+            log(f"[levers] {name}: {what}")
+        r = walk.run(
+            [
+                *args,
+                *overrides,
+                f"cap_s={budget}",
+                f"eval_every_s={budget / 4}",
+                "stop=false",
+                "resume=true",
+                f"run={root / name}",
+                f"figure={root / name / 'walk.png'}",
+            ],
+            log=log,
+        )
+        final = r["evals"][-1]
+        results[name] = {
+            "what": what,
+            "overrides": overrides,
+            "success": final["success"],
+            "track_cm_s": final["track_cm_s"],
+            "mean_steps": final["mean_steps"],
+            "env_steps": r["env_steps"],
+            "steps_per_s": r["steps_per_s"],
+            "time_to_walk_s": r["time_to_walk_s"],
+        }
+    write_markdown(results, budget, walk.REPORTS / "learning_levers.md")
+    return {"budget_s": budget, "levers": results}
+
+
+def _walked_at(seconds: float | None) -> str:
+    return "-" if seconds is None else f"{seconds / 60:.0f} min"
+
+
+def write_markdown(results: dict, budget: float, path: Path) -> None:
+    rows = "\n".join(
+        f"| {name} | {r['what']} | {r['success']:.1f} | {r['track_cm_s']:.1f} | "
+        f"{r['env_steps'] / 1e6:.2f} | {r['steps_per_s']:,.0f} | "
+        f"{_walked_at(r['time_to_walk_s'])} |"
+        for name, r in results.items()
+    )
+    path.write_text(
+        f"# Learning levers at a {budget / 60:.0f}-minute budget\n\n"
+        "`python -m lca.bench levers`: blind MLP, flat ground, `scale=cpu`, 2 CPU cores. "
+        "Success and tracking: the paper's protocol on a flat cell (64 units x 1000 steps, "
+        "forward 0.3-0.6 m/s) at the end of the budget.\n\n"
+        "| lever | change | success (%) | track (cm/s) | env steps (M) | steps/s | walked at |\n"
+        "|---|---|---:|---:|---:|---:|---:|\n"
+        f"{rows}\n"
+    )
+
+
+def table(r: dict) -> str:
+    lines = [f"budget {r['budget_s'] / 60:.0f} min"]
+    for name, x in r["levers"].items():
+        lines.append(
+            f"{name:>20}: success {x['success']:5.1f} %  track {x['track_cm_s']:5.1f} cm/s  "
+            f"{x['env_steps'] / 1e6:5.2f} M steps  {x['steps_per_s']:6,.0f} steps/s"
+        )
+    return "\n".join(lines)

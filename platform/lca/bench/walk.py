@@ -1,0 +1,198 @@
+"""Time-to-walk: train a blind MLP on flat ground from scratch at `scale=cpu` until it walks.
+
+    python -m lca.bench walk [--json] [overrides] [cap_s=10800] [eval_every_s=240]
+        [iterations=1500] [run=runs/bench_walk] [resume=false] [stop=true]
+
+Every `eval_every_s` of training wall-clock the current policy is evaluated in-process with
+the paper's protocol on a flat cell (forward commands 0.3-0.6 m/s, 1000-step episodes,
+observation noise, no randomisation); that time is not counted. The policy *walks* at the
+first evaluation with success >= 90 % and tracking error <= 20 cm/s while the objective is
+the paper's (the reward curriculum, if any, has finished). Reports time_to_walk_s,
+steps_to_walk, steps/s, writes the curve figure reports/bench/walk.png and the run directory
+(a complete run: config, provenance, curve, checkpoints, exported policy).
+"""
+
+from __future__ import annotations
+
+import shutil
+from collections.abc import Callable
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from lca.cli import split_option  # noqa: E402
+from lca.config import compose  # noqa: E402
+from lca.config.runtime import set_torch_threads  # noqa: E402
+from lca.config.schema import EvalCell  # noqa: E402
+from lca.evaluate.probe import TrainingProbe  # noqa: E402
+from lca.learn.rundir import RunDir  # noqa: E402
+from lca.learn.trainer import Trainer  # noqa: E402
+
+BASE = ["terrain=flat", "curriculum=blind", "actor=mlp", "encoder=mlp", "logger=none"]
+# the probe's protocol, recorded in the run's config.yaml so `python -m lca.evaluate` on the
+# run (flat cell) repeats the last probe exactly: same cell config, seeds and sizes
+PROTOCOL = ["eval.units=64", "eval.episodes=1", "eval.steps=1000"]
+REPORTS = Path(__file__).resolve().parents[3] / "reports"
+FLAT_CELL = EvalCell("flat", "medium")
+SUCCESS_MIN = 90.0  # %
+TRACK_MAX = 20.0  # cm/s
+OPTIONS = {
+    "cap_s": 3 * 3600.0,
+    "eval_every_s": 240.0,
+    "iterations": 1500,
+    "run": "runs/bench_walk",
+    "resume": "false",
+    "stop": "true",
+    "figure": str(REPORTS / "bench" / "walk.png"),
+}
+
+
+def parse(args: list[str]) -> tuple[dict, list[str]]:
+    opts = dict(OPTIONS)
+    for key, default in OPTIONS.items():
+        values, args = split_option(args, key)
+        if values:
+            opts[key] = type(default)(values[-1])
+    return opts, args
+
+
+def walks(row: dict) -> bool:
+    return (
+        row["success"] >= SUCCESS_MIN
+        and row["track_cm_s"] <= TRACK_MAX
+        and row["penalty_scale"] >= 1.0
+    )
+
+
+def run(args: list[str], log: Callable[[str], None] | None = print) -> dict:
+    opts, overrides = parse(args)
+    overrides = [*BASE, *PROTOCOL, f"scale.max_iterations={int(opts['iterations'])}", *overrides]
+    cfg = compose(overrides)
+    run = RunDir(opts["run"])
+    if opts["resume"] != "true":
+        shutil.rmtree(run.path, ignore_errors=True)
+    elif run.complete:
+        walked = next(
+            (r for r in TrainingProbe.read(run.path / "probe_evals.csv") if walks(r)), None
+        )
+        return summarise(run, overrides, opts, walked)
+    run.path.mkdir(parents=True, exist_ok=True)
+    run.write_provenance(cfg, overrides, {"bench": "walk"})
+    set_torch_threads(int(cfg.torch_threads))
+    probe = TrainingProbe(
+        cfg, run.path / "probe_evals.csv", FLAT_CELL, cfg.eval.units, cfg.eval.steps
+    )
+    trainer = Trainer(cfg, run)
+    state = {"next": 0.0, "walked": None}
+    for row in TrainingProbe.read(probe.out):  # a resumed benchmark keeps its earlier evaluations
+        state["next"] = row["train_wall_s"] + opts["eval_every_s"]
+        state["walked"] = state["walked"] or (row if walks(row) else None)
+
+    def hook(trainer: Trainer, it: int, row: dict) -> bool:
+        wall = float(row["wall_s"])
+        last = it + 1 == trainer.total or wall >= opts["cap_s"]
+        if wall < state["next"] and not last:
+            return False
+        state["next"] = wall + opts["eval_every_s"]
+        result = probe.evaluate(trainer.alg.get_policy())
+        entry = {
+            "iteration": it,
+            "env_steps": row["env_steps"],
+            "train_wall_s": wall,
+            "penalty_scale": row["penalty_scale"],
+            **result,
+        }
+        probe.record(entry)
+        if log:
+            log(
+                f"[walk] {wall / 60:6.1f} min {row['env_steps'] / 1e6:6.2f} M steps | success "
+                f"{result['success']:5.1f} % | track {result['track_cm_s']:5.1f} cm/s | "
+                f"penalties x{row['penalty_scale']:.2f} | eval {result['eval_s']:.0f} s"
+            )
+        if walks(entry) and state["walked"] is None:
+            state["walked"] = entry
+        return last or (state["walked"] is not None and opts["stop"] == "true")
+
+    if not run.complete:
+        trainer.train(hook=hook)
+        trainer.export()
+    result = summarise(run, overrides, opts, state["walked"])
+    run.mark_complete({k: v for k, v in result.items() if k != "evals"})
+    return result
+
+
+def summarise(run: RunDir, overrides: list[str], opts: dict, walked: dict | None) -> dict:
+    cfg = compose(overrides)
+    curve = pd.read_csv(run.curve)
+    evals = pd.read_csv(run.path / "probe_evals.csv")
+    plot(evals, Path(opts["figure"]))
+    train_s = float(curve["wall_s"].iloc[-1])
+    return {
+        "overrides": overrides,
+        "walked": walked is not None,
+        "time_to_walk_s": walked["train_wall_s"] if walked else None,
+        "steps_to_walk": int(walked["env_steps"]) if walked else None,
+        "iterations_to_walk": int(walked["iteration"]) + 1 if walked else None,
+        "train_s": train_s,
+        "env_steps": int(curve["env_steps"].iloc[-1]),
+        "steps_per_s": float(curve["env_steps"].iloc[-1] / train_s),
+        "criteria": {"success_min": SUCCESS_MIN, "track_max_cm_s": TRACK_MAX},
+        "probe": {
+            "units": int(cfg.eval.units),
+            "steps": int(cfg.eval.steps),
+            "cell": "flat-medium",
+        },
+        "evals": evals.to_dict(orient="records"),
+        "run_dir": str(run.path),
+    }
+
+
+def plot(evals: pd.DataFrame, out: Path) -> None:
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig, axes = plt.subplots(1, 2, figsize=(11, 3.6))
+    minutes = evals["train_wall_s"] / 60
+    for ax, col, limit, label in (
+        (axes[0], "success", SUCCESS_MIN, "success (%)"),
+        (axes[1], "track_cm_s", TRACK_MAX, "tracking error (cm/s)"),
+    ):
+        ax.plot(minutes, evals[col], marker="o", lw=1.5)
+        ax.axhline(limit, color="grey", ls="--", lw=1)
+        ax.set_xlabel("training wall-clock (min, 2 CPU cores)")
+        ax.set_title(label, fontsize=10)
+        ax.grid(alpha=0.3)
+        top = ax.secondary_xaxis(
+            "top",
+            functions=(
+                lambda m, e=evals: _interp(m, e.train_wall_s / 60, e.env_steps / 1e6),
+                lambda s, e=evals: _interp(s, e.env_steps / 1e6, e.train_wall_s / 60),
+            ),
+        )
+        top.set_xlabel("environment steps (M)", fontsize=8)
+    fig.suptitle("Time to walk: blind MLP, flat ground, scale=cpu", fontsize=11)
+    fig.tight_layout()
+    fig.savefig(out, dpi=120)
+    plt.close(fig)
+
+
+def _interp(x, xp, fp):
+    import numpy as np
+
+    return np.interp(x, np.asarray(xp, float), np.asarray(fp, float))
+
+
+def table(r: dict) -> str:
+    lines = [
+        f"walked: {r['walked']}  time_to_walk_s: {r['time_to_walk_s']}  "
+        f"steps_to_walk: {r['steps_to_walk']}  steps/s: {r['steps_per_s']:,.0f}",
+        f"{'min':>6} {'M steps':>8} {'success %':>9} {'track cm/s':>10} {'penalties':>9}",
+    ]
+    for e in r["evals"]:
+        lines.append(
+            f"{e['train_wall_s'] / 60:6.1f} {e['env_steps'] / 1e6:8.2f} {e['success']:9.1f} "
+            f"{e['track_cm_s']:10.1f} {e['penalty_scale']:9.2f}"
+        )
+    return "\n".join(lines)

@@ -1,0 +1,56 @@
+"""The reward curriculum: penalties grow from a fraction of the paper's weights to 1.
+
+A young policy's penalties outweigh its rewards, so early on the cheapest way to a high
+return is to fall at once, or to stand still. Scaling the negative contributions of the
+configured terms (all by default) by `scale` < 1 lets tracking and the gait reward lead.
+The scale rises with the mean episode length or linearly with the iteration, never falls,
+and is exactly 1 from `deadline` x max_iterations on, so every run ends on the paper's
+objective.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from lca.config.schema import RewardCurriculumConfig
+
+
+class RewardCurriculum:
+    def __init__(
+        self, cfg: RewardCurriculumConfig, total_iterations: int, scale: float | None = None
+    ):
+        self.cfg = cfg
+        self.deadline = math.ceil(cfg.deadline * total_iterations) if cfg.enabled else 0
+        start = cfg.penalty_start if cfg.enabled else 1.0
+        self.scale = float(start if scale is None else scale)
+
+    def target(self, iteration: int, episode_fraction: float) -> float:
+        """Scale asked for by the mean episode length (fraction of the maximum) or, with
+        `by: iterations`, by the iteration (a linear ramp to the deadline)."""
+        c = self.cfg
+        if c.by == "iterations":
+            progress = iteration / max(self.deadline, 1)
+        elif np.isfinite(episode_fraction):
+            progress = (episode_fraction - c.length_start) / (c.length_end - c.length_start)
+        else:
+            progress = 0.0
+        return float(c.penalty_start + (1.0 - c.penalty_start) * np.clip(progress, 0, 1))
+
+    def update(self, iteration: int, episode_fraction: float) -> float:
+        """The scale for `iteration`, given the latest mean episode length fraction."""
+        if not self.cfg.enabled or iteration >= self.deadline:
+            self.scale = 1.0
+        else:
+            self.scale = max(self.scale, self.target(iteration, episode_fraction))
+        return self.scale
+
+    @property
+    def only_positive(self) -> bool:
+        return bool(self.cfg.enabled and self.cfg.only_positive and self.scale < 1.0)
+
+    @property
+    def done(self) -> bool:
+        """True once the objective is the paper's: full penalties, no clipping."""
+        return self.scale >= 1.0 and not self.only_positive

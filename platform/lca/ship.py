@@ -1,0 +1,81 @@
+"""Copy a trained run directory into the repository, small: `assets/policies/<name>/`.
+
+    python -m lca.ship <run_dir> <dest> [--resumable]
+
+Kept: config.yaml, provenance.json, train_curve.csv, the in-training evaluations, summary.csv
+and results.parquet (when evaluated), exported/ (ONNX + TorchScript) and the final
+checkpoint without its optimizer state (evaluation and export need only the networks).
+`--resumable` ships `checkpoints/latest.pt` whole instead, so an unfinished training can be
+resumed by a later session (`cp -r dest runs/...` and re-run the same command).
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import sys
+from pathlib import Path
+
+import torch
+
+FILES = (
+    "config.yaml",
+    "provenance.json",
+    "train_curve.csv",
+    "probe_evals.csv",
+    "summary.csv",
+    "results.parquet",
+    "COMPLETE",
+)
+DROPPED_KEYS = ("optimizer_state_dict",)
+
+
+def slim_checkpoint(src: Path, dest: Path) -> None:
+    """`src` without the optimizer state (about two thirds of a PPO checkpoint)."""
+    state = torch.load(src, map_location="cpu", weights_only=False)
+    for key in DROPPED_KEYS:
+        state.pop(key, None)
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    torch.save(state, dest)
+
+
+def ship(run_dir: Path, dest: Path, resumable: bool = False) -> list[Path]:
+    run_dir, dest = Path(run_dir), Path(dest)
+    if not (run_dir / "config.yaml").exists():
+        raise FileNotFoundError(f"{run_dir} has no config.yaml: not a run directory")
+    shutil.rmtree(dest, ignore_errors=True)
+    dest.mkdir(parents=True)
+    for name in FILES:
+        if (run_dir / name).exists():
+            shutil.copy2(run_dir / name, dest / name)
+    if (run_dir / "exported").exists():
+        shutil.copytree(run_dir / "exported", dest / "exported")
+    checkpoints = run_dir / "checkpoints"
+    if resumable:
+        shutil.copy2(checkpoints / "latest.pt", _mkdir(dest / "checkpoints") / "latest.pt")
+    else:
+        finals = sorted(checkpoints.glob("final_*.pt"))
+        if not finals:
+            raise FileNotFoundError(f"{checkpoints} has no final_*.pt (or ship --resumable)")
+        slim_checkpoint(finals[-1], dest / "checkpoints" / finals[-1].name)
+    return sorted(p for p in dest.rglob("*") if p.is_file())
+
+
+def _mkdir(path: Path) -> Path:
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m lca.ship")
+    parser.add_argument("run_dir", type=Path)
+    parser.add_argument("dest", type=Path)
+    parser.add_argument("--resumable", action="store_true")
+    args = parser.parse_args(argv)
+    for path in ship(args.run_dir, args.dest, args.resumable):
+        print(f"{path.stat().st_size / 1e6:7.2f} MB  {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,84 @@
+"""The reward curriculum: penalties start at a fraction, grow with the episode length, never
+shrink, and are exactly the paper's from the deadline on; a real run ends on the paper's
+objective and logs the scale, the learning rate and the KL."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lca.config.schema import CommandCurriculumConfig, RewardCurriculumConfig
+from lca.learn.command_curriculum import CommandCurriculum
+from lca.learn.reward_curriculum import RewardCurriculum
+
+from .helpers import make_trainer, read_curve, smoke_cfg
+
+CFG = RewardCurriculumConfig(
+    enabled=True, penalty_start=0.2, length_start=0.2, length_end=0.6, deadline=0.5
+)
+
+
+def test_scale_follows_episode_length_and_never_shrinks():
+    c = RewardCurriculum(CFG, total_iterations=100)
+    assert c.scale == 0.2
+    assert c.update(0, float("nan")) == 0.2  # no finished episode yet
+    assert c.update(1, 0.1) == 0.2
+    assert c.update(2, 0.4) == pytest.approx(0.2 + 0.8 * 0.5)
+    assert c.update(3, 0.05) == pytest.approx(0.6)  # shorter episodes do not lower it
+    assert c.update(4, 0.6) == 1.0
+    assert c.done
+
+
+def test_scale_is_exactly_one_from_the_deadline_whatever_the_episodes():
+    c = RewardCurriculum(CFG, total_iterations=10)
+    scales = [c.update(it, 0.0) for it in range(10)]
+    assert scales[:5] == [0.2] * 5
+    assert scales[5:] == [1.0] * 5
+    assert c.done and not c.only_positive
+
+
+def test_only_positive_is_an_early_stage_only():
+    cfg = RewardCurriculumConfig(enabled=True, only_positive=True, deadline=0.5)
+    c = RewardCurriculum(cfg, total_iterations=4)
+    c.update(0, 0.0)
+    assert c.only_positive and not c.done
+    c.update(2, 0.0)
+    assert not c.only_positive and c.done
+
+
+def test_disabled_curriculum_is_the_paper_objective_from_the_start():
+    c = RewardCurriculum(RewardCurriculumConfig(enabled=False), total_iterations=10)
+    assert c.update(0, 0.0) == 1.0 and c.done
+
+
+def test_training_run_ends_on_the_paper_objective(tmp_path, smoke_scene):
+    cfg = smoke_cfg(
+        "scale.max_iterations=4",
+        "task.reward_curriculum.enabled=true",
+        "task.reward_curriculum.penalty_start=0.3",
+        "task.reward_curriculum.deadline=0.5",
+    )
+    trainer = make_trainer(cfg, tmp_path / "run", smoke_scene)
+    trainer.train()
+    rows = read_curve(tmp_path / "run" / "train_curve.csv")
+    assert [float(r["penalty_scale"]) for r in rows] == [0.3, 0.3, 1.0, 1.0]
+    assert trainer.env.penalty_scale == 1.0 and not trainer.env.only_positive
+    assert all(float(r["learning_rate"]) > 0 for r in rows)
+    assert all(np.isfinite(float(r["kl"])) for r in rows)  # the adaptive schedule's KL
+
+
+def test_iteration_ramp_is_linear_to_the_deadline():
+    cfg = RewardCurriculumConfig(enabled=True, penalty_start=0.2, by="iterations", deadline=0.5)
+    c = RewardCurriculum(cfg, total_iterations=20)
+    scales = [c.update(it, 1.0) for it in range(20)]  # episode length plays no part
+    np.testing.assert_allclose(scales[:10], 0.2 + 0.8 * np.arange(10) / 10)
+    assert scales[10:] == [1.0] * 10
+
+
+def test_command_floor_falls_linearly_to_zero_at_the_deadline():
+    cfg = CommandCurriculumConfig(enabled=True, min_speed=0.3, deadline=0.5)
+    c = CommandCurriculum(cfg, total_iterations=20)
+    floors = [c.floor(it) for it in range(20)]
+    np.testing.assert_allclose(floors[:10], 0.3 * (1 - np.arange(10) / 10))
+    assert floors[10:] == [0.0] * 10
+    assert CommandCurriculum(CommandCurriculumConfig(), 20).floor(0) == 0.0
