@@ -119,11 +119,14 @@ def run_hardware_stage(spec: dict, extra: list[str], runs_root: Path) -> int:
     from lca.evaluate.hardware import run_hardware
     from lca.evaluate.policy import load_run_config
     from lca.report.build import build_report
-    from lca.report.collect import find_run_dirs
+    from lca.report.collect import find_run_dirs, run_status
 
     wanted = {f"policy={p}" for p in spec["policies"]}
     runs = []
     for run_dir in find_run_dirs([runs_root]):
+        if run_status(run_dir)[0] != "complete":
+            print(f"[lca] hardware: skipping {run_dir} ({run_status(run_dir)[0]})")
+            continue
         overrides = json.loads((run_dir / "provenance.json").read_text())["overrides"]
         if wanted & set(overrides):
             hw = [o for o in extra if o.startswith("hardware.")]

@@ -27,11 +27,12 @@ FILES = (
     "results.parquet",
     "COMPLETE",
 )
-DROPPED_KEYS = ("optimizer_state_dict",)
+DROPPED_KEYS = ("optimizer_state_dict", "lca_loop_state")
 
 
 def slim_checkpoint(src: Path, dest: Path) -> None:
-    """`src` without the optimizer state (about two thirds of a PPO checkpoint)."""
+    """`src` without the optimizer state and the training loop's state (env, RNG): what
+    evaluation and export need."""
     state = torch.load(src, map_location="cpu", weights_only=False)
     for key in DROPPED_KEYS:
         state.pop(key, None)

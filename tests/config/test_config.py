@@ -64,6 +64,19 @@ def test_unknown_terrain_type_in_mixture(override: str) -> None:
         (["terrain=flat", "terrain.mixture.flat=0.5"], "terrain.mixture"),
         (["terrain.mixture.uneven=-0.25", "terrain.mixture.flat=0.75"], "terrain.mixture"),
         (["terrain.resolution=0.03"], "terrain.tile_size"),
+        (["algo.learning_rate=-1"], "algo.learning_rate"),
+        (["algo.gamma=1.5"], "algo.gamma"),
+        (["algo.num_mini_batches=0"], "algo.num_mini_batches"),
+        (["algo.entropy_coef=-0.1"], "algo.entropy_coef"),
+        (["algo.schedule=cosine"], "algo.schedule"),
+        (["scale.max_iterations=0"], "scale.max_iterations"),
+        (["scale.log_interval=0"], "scale.log_interval"),
+        (["scale.checkpoint_interval=0"], "scale.checkpoint_interval"),
+        (["task.num_envs=-5"], "task.num_envs"),
+        (["task.reward_curriculum.by=vibes"], "task.reward_curriculum.by"),
+        (["task.reward_curriculum.terms=[joy]"], "task.reward_curriculum.terms"),
+        (["actor.final_noise_std=2.0"], "actor.final_noise_std"),
+        (["terrain.apron=-1"], "terrain.apron"),
     ],
 )
 def test_bad_values_name_the_key(overrides: list[str], key: str) -> None:
@@ -76,3 +89,10 @@ def test_bad_values_name_the_key(overrides: list[str], key: str) -> None:
 def test_mixture_weights_message_is_informative() -> None:
     with pytest.raises(ConfigError, match=r"^terrain\.mixture: weights must sum to 1"):
         compose(["terrain=mixed", "terrain.mixture.flat=0.5"])
+
+
+def test_dead_key_scale_num_envs_is_gone() -> None:
+    """The number of environments is `task.num_envs`; `scale.num_envs` was never read."""
+    with pytest.raises((ConfigCompositionException, ConfigError)) as err:
+        compose(["scale.num_envs=-5"])
+    assert "scale.num_envs" in str(err.value)

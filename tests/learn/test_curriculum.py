@@ -106,10 +106,14 @@ def test_two_stage_curve_and_checkpoints(two_stage) -> None:
     rows = read_curve(trainer.run.curve)
     assert [r["stage"] for r in rows] == ["blind", "blind", "perception", "perception"]
     names = {p.name for p in trainer.run.checkpoints.iterdir()}
-    assert names == {f"stage1_blind_it{SWITCH - 1}.pt", "final_perception.pt", "latest.pt"}
+    assert names == {
+        f"stage1_blind_it{SWITCH - 1}.pt",
+        "final_perception.pt",
+        "latest.pt",
+    }
     stage1 = _load(trainer, f"stage1_blind_it{SWITCH - 1}.pt")
     assert stage1["iter"] == SWITCH - 1
-    assert stage1["infos"] == {"stage": "blind"}
+    assert stage1["infos"] == {"stage": "blind", "penalty_scale": 1.0}
 
 
 def test_actor_map_follows_stage_within_rollouts(two_stage) -> None:

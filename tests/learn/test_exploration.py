@@ -29,3 +29,22 @@ def test_training_std_stays_under_the_ceiling(tmp_path, smoke_scene):
     for it, std in enumerate(stds):
         assert std <= noise_ceiling(cfg.actor, it, 4) + 1e-6
     assert stds[-1] == pytest.approx(0.5, abs=1e-6)
+
+
+def test_per_joint_initial_std(tmp_path, smoke_scene):
+    cfg = smoke_cfg("scale.max_iterations=1")
+    cfg.actor.init_noise_std_joints = {".*_knee_joint": 0.3}
+    trainer = make_trainer(cfg, tmp_path / "run", smoke_scene)
+    std = trainer.alg.get_policy().distribution.std_param.detach()
+    names = trainer.env.scene.joint_names
+    for i, name in enumerate(names):
+        assert std[i] == pytest.approx(0.3 if "knee" in name else cfg.actor.init_noise_std)
+
+
+def test_ceiling_can_follow_the_penalties():
+    cfg = ActorConfig(
+        init_noise_std=1.0, final_noise_std=0.4, noise_deadline=0.5, noise_by="penalties"
+    )
+    assert noise_ceiling(cfg, 0, 20, penalty_progress=0.0) == pytest.approx(1.0)
+    assert noise_ceiling(cfg, 3, 20, penalty_progress=0.5) == pytest.approx(0.7)
+    assert noise_ceiling(cfg, 10, 20, penalty_progress=0.0) == pytest.approx(0.4)  # deadline

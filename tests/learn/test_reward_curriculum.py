@@ -82,3 +82,25 @@ def test_command_floor_falls_linearly_to_zero_at_the_deadline():
     np.testing.assert_allclose(floors[:10], 0.3 * (1 - np.arange(10) / 10))
     assert floors[10:] == [0.0] * 10
     assert CommandCurriculum(CommandCurriculumConfig(), 20).floor(0) == 0.0
+
+
+def test_tracking_gate_steps_up_only_while_the_robot_tracks():
+    cfg = RewardCurriculumConfig(
+        enabled=True,
+        penalty_start=0.2,
+        by="tracking",
+        gate=0.5,
+        ramp=0.4,
+        length_start=0.3,
+        deadline=0.9,
+    )
+    c = RewardCurriculum(cfg, total_iterations=20)  # a full ramp: 8 gated steps of 0.1
+    assert c.update(0, 0.9, 0.6) == pytest.approx(0.3)
+    assert c.update(1, 0.9, 0.4) == pytest.approx(0.3)  # tracking below the gate: hold
+    assert c.update(2, 0.2, 0.9) == pytest.approx(0.3)  # episodes too short: hold
+    assert c.update(3, 0.9, float("nan")) == pytest.approx(0.3)
+    for it in range(4, 11):
+        c.update(it, 0.9, 0.8)
+    assert c.scale == pytest.approx(1.0)
+    late = RewardCurriculum(cfg, total_iterations=20)
+    assert late.update(18, 0.0, 0.0) == 1.0  # the deadline, whatever the robot does

@@ -209,3 +209,38 @@ def test_unknown_actor_fails_listing_options(grid, tmp_path) -> None:
     assert sorted(options) == ["lstm", "mlp"]
     assert complete_runs(runs_root) == []
     assert not list(tmp_path.rglob("*.pt"))
+
+
+def test_two_processes_on_one_run_one_owner(tmp_path) -> None:
+    """Two identical `python run.py` started together: one trains the run to COMPLETE with
+    its whole curve, the other stops at once naming the owner."""
+    args = [
+        "scale=smoke",
+        "logger=none",
+        "torch_threads=1",
+        "scale.max_iterations=6",
+        "eval.units=2",
+        "eval.episodes=1",
+        "eval.steps=5",
+        f"runs_root={tmp_path}",
+    ]
+    procs = [
+        subprocess.Popen(
+            cli_command(*args),
+            cwd=tmp_path,
+            env=cli_env(),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        for _ in range(2)
+    ]
+    outs = [p.communicate(timeout=300) for p in procs]
+    codes = sorted(p.returncode for p in procs)
+    assert codes[0] == 0 and codes[1] != 0, outs
+    loser = next(err for p, (_, err) in zip(procs, outs, strict=True) if p.returncode != 0)
+    assert "is in use by PID" in loser
+    runs = complete_runs(tmp_path)
+    assert len(runs) == 1
+    rows = read_curve(runs[0] / "train_curve.csv")
+    assert [int(r["iteration"]) for r in rows] == list(range(6))

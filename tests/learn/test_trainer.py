@@ -66,13 +66,13 @@ def test_combination_trains(actor, encoder, curriculum, smoke_scene, tmp_path) -
     assert float(rows[-1]["value_loss"]) == pytest.approx(last["value_loss"])
 
     ckpts = trainer.run.checkpoints
-    expected = {"latest.pt", f"final_{STAGES[curriculum][-1]}.pt"}
+    expected = {"latest.pt", "previous.pt", f"final_{STAGES[curriculum][-1]}.pt"}
     if curriculum == "two":
         expected.add("stage1_blind_it0.pt")
     assert {p.name for p in ckpts.iterdir()} == expected
     saved = torch.load(ckpts / "latest.pt", weights_only=False, map_location="cpu")
     assert saved["iter"] == 1
-    assert saved["infos"] == {"stage": STAGES[curriculum][-1]}
+    assert saved["infos"] == {"stage": STAGES[curriculum][-1], "penalty_scale": 1.0}
     _assert_architecture(saved["actor_state_dict"], actor, encoder)
     _assert_architecture(saved["critic_state_dict"], None, encoder)
     assert "rnn.rnn.weight_ih_l0" not in saved["critic_state_dict"]
@@ -175,3 +175,10 @@ def test_wandb_offline_run(tmp_path, monkeypatch, restore_wandb_env) -> None:
     runs = sorted((path / "wandb").glob("offline-run-*"))
     assert len(runs) == 1, runs
     assert list(runs[0].glob("run-*.wandb")), list(runs[0].iterdir())
+    # the final checkpoint reaches wandb under its final name, as a readable file
+    files = runs[0] / "files"
+    saved = [p for p in files.rglob("*.pt")]
+    assert any(p.name.startswith("final_") for p in saved), list(files.rglob("*"))
+    for p in saved:
+        assert not p.name.endswith(".tmp")
+        assert p.resolve().is_file(), f"{p} is a broken link"

@@ -118,9 +118,10 @@ def build_fixture_store(root: Path) -> Path:
         }
         (path / "provenance.json").write_text(json.dumps(provenance, indent=2))
         train_curve(index).to_csv(path / "train_curve.csv", index=False)
-        if run.get("results", True):
+        if run.get("results", True):  # an evaluated run is complete; the others are not
             frame = results_frame(run["folder"], cells, spec["units"], spec["episodes"])
             frame.to_parquet(path / "results.parquet", index=False)
+            (path / "COMPLETE").write_text("{}")
     (root / NOT_A_RUN).mkdir()
     (root / NOT_A_RUN / "README.txt").write_text("not a run directory\n")
     return root

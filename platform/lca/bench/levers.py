@@ -13,8 +13,11 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
+from lca.bench import env as env_bench
 from lca.bench import walk
 from lca.cli import split_option
+from lca.config import compose
+from lca.sim.scene import build_scene
 
 # name -> (what it changes, overrides on top of the scale=cpu recipe)
 LEVERS: dict[str, tuple[str, list[str]]] = {
@@ -44,13 +47,12 @@ LEVERS: dict[str, tuple[str, list[str]]] = {
     "fixed_lr": ("fixed learning rate 3e-4", ["algo.schedule=fixed", "algo.learning_rate=3e-4"]),
     "envs_512x12": (
         "512 envs x 12 steps",
-        ["scale.num_envs=512", "task.num_envs=512", "algo.num_steps_per_env=12"],
+        ["task.num_envs=512", "algo.num_steps_per_env=12"],
     ),
     "envs_128x48": (
         "128 envs x 48 steps",
-        ["scale.num_envs=128", "task.num_envs=128", "algo.num_steps_per_env=48"],
+        ["task.num_envs=128", "algo.num_steps_per_env=48"],
     ),
-    "heightfield_floor": ("flat ground as a heightfield", ["terrain.flat_as_plane=false"]),
     "small_networks": (
         "actor and critic {256, 128, 128} (report only)",
         ["actor.hidden_dims=[256,128,128]"],
@@ -97,15 +99,40 @@ def run(args: list[str], log: Callable[[str], None] | None = print) -> dict:
             "steps_per_s": r["steps_per_s"],
             "time_to_walk_s": r["time_to_walk_s"],
         }
-    write_markdown(results, budget, walk.REPORTS / "learning_levers.md")
-    return {"budget_s": budget, "levers": results}
+    physics = physics_cost(log)
+    write_markdown(results, physics, budget, walk.REPORTS / "learning_levers.md")
+    return {"budget_s": budget, "levers": results, "physics": physics}
+
+
+# physics-cost levers: env steps/s (N=256, 2 threads, random actions) on flat ground
+PHYSICS = {
+    "plane (default)": [],
+    "heightfield floor": ["terrain.flat_as_plane=false"],
+}
+
+
+def physics_cost(log: Callable[[str], None] | None = print) -> dict:
+    rows = {}
+    for name, overrides in PHYSICS.items():
+        cfg = compose([*walk.BASE, *overrides])
+        row = env_bench.measure(cfg, build_scene(cfg), 256, 2)
+        rows[name] = {"overrides": overrides, "steps_per_s": row["steps_per_s"]}
+        if log:
+            log(f"[levers] physics {name}: {row['steps_per_s']:,.0f} env steps/s")
+    return rows
 
 
 def _walked_at(seconds: float | None) -> str:
     return "-" if seconds is None else f"{seconds / 60:.0f} min"
 
 
-def write_markdown(results: dict, budget: float, path: Path) -> None:
+def write_markdown(results: dict, physics: dict, budget: float, path: Path) -> None:
+    base = next(iter(physics.values()))["steps_per_s"]
+    physics_rows = "\n".join(
+        f"| {name} | `{' '.join(r['overrides']) or '-'}` | {r['steps_per_s']:,.0f} | "
+        f"{r['steps_per_s'] / base:.2f} |"
+        for name, r in physics.items()
+    )
     rows = "\n".join(
         f"| {name} | {r['what']} | {r['success']:.1f} | {r['track_cm_s']:.1f} | "
         f"{r['env_steps'] / 1e6:.2f} | {r['steps_per_s']:,.0f} | "
@@ -119,7 +146,11 @@ def write_markdown(results: dict, budget: float, path: Path) -> None:
         "forward 0.3-0.6 m/s) at the end of the budget.\n\n"
         "| lever | change | success (%) | track (cm/s) | env steps (M) | steps/s | walked at |\n"
         "|---|---|---:|---:|---:|---:|---:|\n"
-        f"{rows}\n"
+        f"{rows}\n\n"
+        "Physics cost on flat ground (`LocomotionEnv.step`, 256 envs, 2 threads, random "
+        "actions, median of 3):\n\n"
+        "| floor | overrides | env steps/s | ratio |\n|---|---|---:|---:|\n"
+        f"{physics_rows}\n"
     )
 
 

@@ -107,6 +107,7 @@ def run(args: list[str], log: Callable[[str], None] | None = print) -> dict:
             **result,
         }
         probe.record(entry)
+        trainer.save(f"probe_it{it}.pt", it)  # each evaluated policy, to look at or resume
         if log:
             log(
                 f"[walk] {wall / 60:6.1f} min {row['env_steps'] / 1e6:6.2f} M steps | success "
@@ -118,8 +119,9 @@ def run(args: list[str], log: Callable[[str], None] | None = print) -> dict:
         return last or (state["walked"] is not None and opts["stop"] == "true")
 
     if not run.complete:
-        trainer.train(hook=hook)
-        trainer.export()
+        with run.lock():
+            trainer.train(hook=hook)
+            trainer.export()
     result = summarise(run, overrides, opts, state["walked"])
     run.mark_complete({k: v for k, v in result.items() if k != "evals"})
     return result

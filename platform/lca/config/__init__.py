@@ -1,6 +1,13 @@
 """Structured Hydra configs: schema dataclasses, validation and composition."""
 
-from lca.config.compose import ConfigError, compose, conf_dir, load_option, validate
+from lca.config.compose import (
+    ConfigError,
+    compose,
+    conf_dir,
+    load_option,
+    override_config,
+    validate,
+)
 from lca.config.runtime import register_resolvers, resolve_device, set_torch_threads
 from lca.config.schema import LcaConfig
 
@@ -12,6 +19,7 @@ __all__ = [
     "compose",
     "conf_dir",
     "load_option",
+    "override_config",
     "resolve_device",
     "set_torch_threads",
     "validate",

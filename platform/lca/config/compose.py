@@ -64,3 +64,44 @@ def compose(overrides: list[str] | None = None, config_name: str = "config") -> 
         cfg = hydra_compose(config_name=config_name, overrides=list(overrides or []))
     validate(cfg)
     return cfg
+
+
+def _delta(before, after):
+    """The leaves of `after` that differ from `before` (nested dicts; lists compared whole)."""
+    if isinstance(before, dict) and isinstance(after, dict):
+        out = {}
+        for key, value in after.items():
+            if key not in before:
+                out[key] = value
+            else:
+                sub = _delta(before[key], value)
+                if sub is not _SAME:
+                    out[key] = sub
+        return out or _SAME
+    return _SAME if before == after else after
+
+
+_SAME = object()
+
+
+def override_config(
+    base: DictConfig, overrides: list[str], base_overrides: list[str] | None = None
+) -> DictConfig:
+    """`base` (a run's resolved config) with `overrides` applied exactly as `run.py` would
+    apply them, group options (`scale=smoke`, `difficulty=hard`) included: the change that
+    the overrides make to the composition of `base_overrides` (the run's own overrides) is
+    merged onto `base`. Raises ConfigError naming a bad key or option."""
+    if not overrides:
+        return base
+    common = list(base_overrides or [])
+    try:
+        before = OmegaConf.to_container(compose(common), resolve=True)
+    except Exception:  # the run's overrides no longer compose (conf/ changed): start plain
+        before, common = OmegaConf.to_container(compose([]), resolve=True), []
+    after = OmegaConf.to_container(compose([*common, *overrides]), resolve=True)
+    change = _delta(before, after)
+    if change is _SAME:
+        return base
+    merged = OmegaConf.merge(base, change)
+    validate(merged)
+    return merged

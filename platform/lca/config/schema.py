@@ -237,9 +237,12 @@ class RewardCurriculumConfig:
 
     enabled: bool = False
     penalty_start: float = 0.1  # fraction of the paper's penalty weights at the start
-    # what raises the scale: the mean episode length (length_start -> length_end), or the
-    # iteration (linearly from 0 to the deadline)
+    # what raises the scale: the mean episode length (length_start -> length_end); the
+    # iteration (linearly from 0 to the deadline); or tracking: a step per iteration while
+    # episodes are long enough (length_start) and the robot follows its commands (gate)
     by: str = "episode_length"
+    gate: float = 0.5  # tracking: 1 - |u - v| / |u| over moving commands needed to step up
+    ramp: float = 0.25  # tracking: fraction of max_iterations a full, never-gated ramp takes
     length_start: float = 0.2  # ramp starts at this mean episode length (fraction of the max)
     length_end: float = 0.8  # ... and reaches the paper's weights at this one
     deadline: float = 0.75  # fraction of max_iterations from which the weights are the paper's
@@ -256,7 +259,8 @@ class RewardCurriculumConfig:
             f"need 0 <= start < end <= 1, got {self.length_start}, {self.length_end}",
         )
         _require(0 <= self.deadline <= 1, f"{key}.deadline", "must be in [0, 1]")
-        allowed = ("episode_length", "iterations")
+        _require(0 < self.ramp <= 1, f"{key}.ramp", "must be in (0, 1]")
+        allowed = ("episode_length", "iterations", "tracking")
         _require(self.by in allowed, f"{key}.by", f"unknown '{self.by}'; allowed: {allowed}")
         from lca.task.rewards import REWARD_TERMS  # task layer owns the names
 
@@ -435,11 +439,17 @@ class ActorConfig:
     activation: str = "elu"
     rnn_hidden_dim: int = 256  # LSTM width before the MLP head (lstm only)
     init_noise_std: float = 1.0
+    # joint group (legs, waist, arms) or joint name regex -> initial action std of its joints
+    # (first match wins); e.g. a quiet upper body while the legs explore
+    init_noise_std_joints: dict[str, float] = field(default_factory=dict)
     # > 0: the action std is capped by a ceiling falling linearly from init_noise_std to this
     # value at `noise_deadline` x max_iterations (and staying there): explore early, act
     # precisely once the penalties are the paper's. 0: rsl-rl's free, learned std.
     final_noise_std: float = 0.0
     noise_deadline: float = 0.6
+    # what lowers the ceiling: the iteration (to noise_deadline) or the reward curriculum's
+    # progress (the ceiling reaches final_noise_std as the penalties reach the paper's)
+    noise_by: str = "iterations"
 
     def check(self) -> None:
         _require(
@@ -452,6 +462,8 @@ class ActorConfig:
             f"must be in [0, init_noise_std={self.init_noise_std}], got {self.final_noise_std}",
         )
         _require(0 <= self.noise_deadline <= 1, "actor.noise_deadline", "must be in [0, 1]")
+        allowed = ("iterations", "penalties")
+        _require(self.noise_by in allowed, "actor.noise_by", f"allowed: {allowed}")
 
 
 @dataclass
@@ -502,6 +514,31 @@ class AlgoConfig:
     obs_normalization: bool = True
     symmetry: bool = False  # rsl-rl symmetry_cfg: every mini-batch also holds its mirror image
     mirror_loss_coeff: float = 0.0  # > 0 adds rsl-rl's mirror loss (MLP actors only)
+
+    def check(self) -> None:
+        def positive(key: str) -> None:
+            value = getattr(self, key)
+            _require(value > 0, f"algo.{key}", f"must be > 0, got {value}")
+
+        def at_least_one(key: str) -> None:
+            value = getattr(self, key)
+            _require(value >= 1, f"algo.{key}", f"must be >= 1, got {value}")
+
+        for key in ("learning_rate", "clip_param", "max_grad_norm", "desired_kl"):
+            positive(key)
+        for key in ("num_steps_per_env", "num_learning_epochs", "num_mini_batches"):
+            at_least_one(key)
+        for key in ("entropy_coef", "value_loss_coef", "mirror_loss_coeff"):
+            value = getattr(self, key)
+            _require(value >= 0, f"algo.{key}", f"must be >= 0, got {value}")
+        _require(0 < self.gamma <= 1, "algo.gamma", f"must be in (0, 1], got {self.gamma}")
+        _require(0 <= self.lam <= 1, "algo.lam", f"must be in [0, 1], got {self.lam}")
+        allowed = ("adaptive", "fixed")
+        _require(
+            self.schedule in allowed,
+            "algo.schedule",
+            f"unknown '{self.schedule}'; allowed: {allowed}",
+        )
 
 
 EVAL_TERRAINS = ("stairs", "uneven", "flat", "stairs_up", "stairs_down", "mixed")
@@ -561,10 +598,14 @@ class LoggerConfig:
 @dataclass
 class ScaleConfig:
     name: str = "cpu"
-    num_envs: int = 256
     max_iterations: int = 100
     log_interval: int = 5  # iterations between progress lines
     checkpoint_interval: int = 25  # iterations between resumable checkpoints
+
+    def check(self) -> None:
+        for key in ("max_iterations", "log_interval", "checkpoint_interval"):
+            value = getattr(self, key)
+            _require(value >= 1, f"scale.{key}", f"must be >= 1, got {value}")
 
 
 @dataclass

@@ -20,7 +20,7 @@ from lca.config import load_option
 from lca.evaluate.policy import final_checkpoint, load_policy
 from lca.evaluate.protocol import trial_config
 from lca.learn import curriculum
-from lca.learn.rundir import atomic_write
+from lca.learn.rundir import RunDir, atomic_write
 from lca.sim.hardware import HardwareTask, build_task
 from lca.task.env import LocomotionEnv
 
@@ -63,6 +63,11 @@ def run_trials(env: LocomotionEnv, policy, task: HardwareTask, steps: int) -> pd
 def run_hardware(run_dir: Path, cfg: DictConfig, log=print) -> pd.DataFrame:
     """Every task of `cfg.hardware` on the run's final policy; writes hardware.csv."""
     run_dir = Path(run_dir)
+    with RunDir(run_dir).lock():
+        return _run_hardware(run_dir, cfg, log)
+
+
+def _run_hardware(run_dir: Path, cfg: DictConfig, log) -> pd.DataFrame:
     c = task_config(cfg)
     total = int(cfg.scale.max_iterations)
     perception = curriculum.perception_on(cfg.curriculum, total - 1, total)

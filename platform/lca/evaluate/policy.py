@@ -4,26 +4,30 @@ from __future__ import annotations
 
 import contextlib
 import io
+import json
 from pathlib import Path
 
 from omegaconf import DictConfig, OmegaConf
 from rsl_rl.runners import OnPolicyRunner
 
-from lca.config import schema, validate
+from lca.config import override_config, schema, validate
 from lca.config.runtime import resolve_device
 from lca.learn.train_cfg import build_train_cfg
 from lca.task.env import LocomotionEnv
 
 
 def load_run_config(run_dir: Path, overrides: list[str] | None = None) -> DictConfig:
-    """The run's resolved config.yaml, checked against the schema, plus dotlist overrides."""
+    """The run's resolved config.yaml, checked against the schema, with `overrides` applied
+    as `run.py` applies them (dotted keys and group options such as `scale=smoke`)."""
     path = Path(run_dir) / "config.yaml"
     if not path.exists():
         raise FileNotFoundError(f"run_dir: {run_dir} has no config.yaml (not a run directory)")
     cfg = OmegaConf.merge(OmegaConf.structured(schema.LcaConfig), OmegaConf.load(path))
-    if overrides:
-        cfg = OmegaConf.merge(cfg, OmegaConf.from_dotlist(list(overrides)))
     validate(cfg)
+    if overrides:
+        provenance = Path(run_dir) / "provenance.json"
+        own = json.loads(provenance.read_text()).get("overrides", []) if provenance.exists() else []
+        cfg = override_config(cfg, list(overrides), own)
     return cfg
 
 
@@ -50,5 +54,12 @@ def load_policy(cfg: DictConfig, env: LocomotionEnv, checkpoint: Path):
     """The deterministic actor of `checkpoint`: `policy(obs)`, `policy.reset(dones)`."""
     device = resolve_device(cfg.device)
     runner = _runner(cfg, env)
-    runner.load(str(checkpoint), load_cfg={"actor": True}, strict=True, map_location=device)
+    try:
+        runner.load(str(checkpoint), load_cfg={"actor": True}, strict=True, map_location=device)
+    except (RuntimeError, EOFError, OSError, KeyError) as error:
+        reason = str(error).splitlines()[0][:200] if str(error) else type(error).__name__
+        raise RuntimeError(
+            f"cannot read checkpoint {checkpoint}: {reason}. Retrain the run (force=true) or "
+            f"replace the file with a readable checkpoint of the same configuration"
+        ) from error
     return runner.get_inference_policy(device)

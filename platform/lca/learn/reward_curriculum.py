@@ -23,6 +23,7 @@ class RewardCurriculum:
     ):
         self.cfg = cfg
         self.deadline = math.ceil(cfg.deadline * total_iterations) if cfg.enabled else 0
+        self.step = (1.0 - cfg.penalty_start) / max(cfg.ramp * total_iterations, 1.0)
         start = cfg.penalty_start if cfg.enabled else 1.0
         self.scale = float(start if scale is None else scale)
 
@@ -38,10 +39,17 @@ class RewardCurriculum:
             progress = 0.0
         return float(c.penalty_start + (1.0 - c.penalty_start) * np.clip(progress, 0, 1))
 
-    def update(self, iteration: int, episode_fraction: float) -> float:
-        """The scale for `iteration`, given the latest mean episode length fraction."""
-        if not self.cfg.enabled or iteration >= self.deadline:
+    def update(
+        self, iteration: int, episode_fraction: float, tracking: float = float("nan")
+    ) -> float:
+        """The scale for `iteration`, given the latest mean episode length fraction and, for
+        `by: tracking`, the tracking progress 1 - |u - v| / |u| of the last rollout."""
+        c = self.cfg
+        if not c.enabled or iteration >= self.deadline:
             self.scale = 1.0
+        elif c.by == "tracking":
+            if episode_fraction >= c.length_start and tracking >= c.gate:
+                self.scale = min(1.0, self.scale + self.step)
         else:
             self.scale = max(self.scale, self.target(iteration, episode_fraction))
         return self.scale
@@ -49,6 +57,12 @@ class RewardCurriculum:
     @property
     def only_positive(self) -> bool:
         return bool(self.cfg.enabled and self.cfg.only_positive and self.scale < 1.0)
+
+    @property
+    def progress(self) -> float:
+        """0 at the start of the ramp, 1 at the paper's weights."""
+        start = self.cfg.penalty_start if self.cfg.enabled else 0.0
+        return 1.0 if start >= 1.0 else (self.scale - start) / (1.0 - start)
 
     @property
     def done(self) -> bool:

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import csv
 import logging
 import math
 import os
 import time
+from pathlib import Path
 
 from omegaconf import DictConfig
 
@@ -31,6 +33,17 @@ def finite(value):
     return value
 
 
+def curve_totals(curve: Path) -> dict:
+    """Falls and non-finite resets summed over the run (from its train_curve.csv)."""
+    totals = {"falls_total": 0, "nonfinite_total": 0, "nonfinite_actions_total": 0}
+    with open(curve, newline="") as f:
+        for row in csv.DictReader(f):
+            for key in totals:
+                value = row.get(key.removesuffix("_total"), "")
+                totals[key] += int(float(value)) if value not in ("", None) else 0
+    return totals
+
+
 def train_run(cfg: DictConfig, run: RunDir) -> dict:
     threads = job_threads(cfg)
     set_torch_threads(threads)
@@ -44,8 +57,10 @@ def train_run(cfg: DictConfig, run: RunDir) -> dict:
     trainer = Trainer(cfg, run)
     last = trainer.train()
     exported = trainer.export()
+    counters = curve_totals(run.curve)
     return {
         "iterations": int(cfg.scale.max_iterations),
+        **counters,
         "train_wall_s": round(time.perf_counter() - t0, 1),
         "final": finite(last),
         "exported": {k: str(v.relative_to(run.path)) for k, v in exported.items()},

@@ -5,9 +5,12 @@ Stages talk through these files, so any stage can be re-run alone.
 
 from __future__ import annotations
 
+import contextlib
+import fcntl
 import json
 import os
 import platform
+import shutil
 import socket
 import subprocess
 import sys
@@ -18,8 +21,12 @@ from pathlib import Path
 
 from omegaconf import DictConfig, OmegaConf
 
+LOCK = ".lock"
+_HELD: dict[Path, int] = {}  # run directories this process has locked -> nesting depth
 PACKAGES = ("lca", "torch", "mujoco", "mjbatch", "rsl-rl-lib", "hydra-core", "numpy", "tensordict")
 COMPLETE = "COMPLETE"
+FAILED = "FAILED"
+KEEP_ON_FORCE = (".hydra", LOCK)  # Hydra writes .hydra/ before the job starts
 
 
 def atomic_write(path: Path, text: str) -> None:
@@ -52,12 +59,72 @@ def versions() -> dict:
     return found
 
 
+class RunLockedError(RuntimeError):
+    """Another live process owns the run directory."""
+
+
+def _holder(fd: int) -> dict:
+    os.lseek(fd, 0, os.SEEK_SET)
+    text = os.read(fd, 4096).decode(errors="replace").strip()
+    try:
+        return json.loads(text) if text else {}
+    except json.JSONDecodeError:
+        return {"unreadable": text[:80]}
+
+
+def _describe(holder: dict) -> str:
+    if not holder:
+        return "another process"
+    return f"PID {holder.get('pid')} on {holder.get('host')} (since {holder.get('since')})"
+
+
 class RunDir:
     def __init__(self, path: str | Path):
         self.path = Path(path)
         self.checkpoints = self.path / "checkpoints"
         self.exported = self.path / "exported"
         self.curve = self.path / "train_curve.csv"
+
+    @contextlib.contextmanager
+    def lock(self):
+        """Own the run directory for the block: an advisory lock (`.lock`, holding the owner's
+        PID and host). A second process fails at once with a message naming the owner; a lock
+        left by a killed process is released by the kernel and taken over. Re-entrant within
+        one process."""
+        key = self.path.resolve()
+        if _HELD.get(key):
+            _HELD[key] += 1
+            try:
+                yield
+            finally:
+                _HELD[key] -= 1
+            return
+        self.path.mkdir(parents=True, exist_ok=True)
+        fd = os.open(self.path / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = _holder(fd)
+            os.close(fd)
+            raise RunLockedError(
+                f"{self.path} is in use by {_describe(holder)}; wait for it to finish or "
+                f"stop that process (lock file: {self.path / LOCK})"
+            ) from None
+        stale = _holder(fd)
+        if stale:
+            print(f"[lca] {self.path}: taking over the lock left by {_describe(stale)}")
+        me = {"pid": os.getpid(), "host": socket.gethostname(), "since": time.strftime("%c")}
+        os.ftruncate(fd, 0)
+        os.lseek(fd, 0, os.SEEK_SET)
+        os.write(fd, json.dumps(me).encode())
+        _HELD[key] = 1
+        try:
+            yield
+        finally:
+            del _HELD[key]
+            os.ftruncate(fd, 0)  # an empty lock file: released cleanly
+            fcntl.flock(fd, fcntl.LOCK_UN)
+            os.close(fd)
 
     @property
     def complete(self) -> bool:
@@ -68,6 +135,27 @@ class RunDir:
 
     def clear_complete(self) -> None:
         (self.path / COMPLETE).unlink(missing_ok=True)
+
+    @property
+    def failed(self) -> dict | None:
+        """The reason recorded by the last run that failed here, if any."""
+        path = self.path / FAILED
+        return json.loads(path.read_text()) if path.exists() else None
+
+    def mark_failed(self, error: BaseException) -> None:
+        reason = {"error": type(error).__name__, "message": str(error)[:2000]}
+        atomic_write(self.path / FAILED, json.dumps(reason | {"at": time.strftime("%c")}))
+
+    def clear_outputs(self) -> None:
+        """Delete every output of an earlier run (`force=true`): checkpoints, curves, exports,
+        evaluations, results, reports and markers."""
+        for entry in self.path.iterdir() if self.path.exists() else ():
+            if entry.name in KEEP_ON_FORCE:
+                continue
+            if entry.is_dir() and not entry.is_symlink():
+                shutil.rmtree(entry)
+            else:
+                entry.unlink()
 
     def write_provenance(self, cfg: DictConfig, overrides: list[str], choices: dict) -> None:
         repo = Path(__file__).resolve().parents[3]

@@ -12,8 +12,9 @@ import contextlib
 import csv
 import io
 import math
+import os
+import tempfile
 import time
-from collections import deque
 from pathlib import Path
 
 import numpy as np
@@ -24,12 +25,16 @@ from rsl_rl.runners import OnPolicyRunner
 from lca.config.runtime import resolve_device
 from lca.learn import curriculum
 from lca.learn.command_curriculum import CommandCurriculum
-from lca.learn.exploration import apply_ceiling, noise_ceiling
+from lca.learn.episode_stats import EpisodeStats
+from lca.learn.exploration import apply_ceiling, noise_ceiling, set_initial_stds
 from lca.learn.reward_curriculum import RewardCurriculum
 from lca.learn.rundir import RunDir
 from lca.learn.train_cfg import build_train_cfg
 from lca.task.env import LocomotionEnv
+from lca.task.env_state import env_state, restore_env_state
 
+LATEST, PREVIOUS = "latest.pt", "previous.pt"
+LOOP_STATE = "lca_loop_state"  # env, episode statistics, RNG and recurrent states
 CURVE_FIELDS = (
     "iteration",
     "env_steps",
@@ -49,42 +54,19 @@ CURVE_FIELDS = (
     "kl",
     "penalty_scale",
     "command_floor",
+    "tracking_progress",
+    "falls",
+    "nonfinite",
+    "nonfinite_actions",
 )
+BROKEN_STREAK = 3  # iterations whose every episode ends non-finite before a run fails
+MOVING = 0.2  # m/s: commands at least this fast count towards the tracking progress
 
 
-class EpisodeStats:
-    """Returns and lengths of finished episodes (last 100), and per-term episode sums."""
-
-    def __init__(self, num_envs: int, device: torch.device):
-        self.reward = torch.zeros(num_envs, device=device)
-        self.length = torch.zeros(num_envs, device=device)
-        self.returns: deque[float] = deque(maxlen=100)
-        self.lengths: deque[float] = deque(maxlen=100)
-        self.terms: dict[str, list[float]] = {}
-
-    def add(self, rewards: torch.Tensor, dones: torch.Tensor, log: dict) -> None:
-        self.reward += rewards
-        self.length += 1
-        done = dones > 0
-        if done.any():
-            self.returns.extend(self.reward[done].tolist())
-            self.lengths.extend(self.length[done].tolist())
-            self.reward[done] = 0
-            self.length[done] = 0
-        for key, value in log.items():
-            if key.startswith("Episode_Reward/"):
-                self.terms.setdefault(key.split("/", 1)[1], []).append(float(value))
-
-    def summary(self) -> dict:
-        out = {
-            "mean_reward": float(np.mean(self.returns)) if self.returns else math.nan,
-            "mean_episode_length": float(np.mean(self.lengths)) if self.lengths else math.nan,
-        }
-        for name in ("track_lin_vel_xy_exp", "track_ang_vel_z_exp"):
-            values = self.terms.get(name)
-            out[name] = float(np.mean(values)) if values else math.nan
-        self.terms.clear()
-        return out
+def _clone(hidden):
+    if hidden is None:
+        return None
+    return tuple(h.clone() for h in hidden) if isinstance(hidden, tuple) else hidden.clone()
 
 
 def _number(text: str):
@@ -117,13 +99,9 @@ class Trainer:
             self.runner = OnPolicyRunner(self.env, train_cfg, log_dir=log_dir, device=self.device)
         self.alg = self.runner.alg
         self.start = 0
-        infos = None
-        latest = run_dir.latest_checkpoint()
-        if latest is not None:
-            infos = self.runner.load(str(latest), map_location=self.device)
-            # rsl-rl stores the index of the last finished iteration
-            self.start = self.runner.current_learning_iteration + 1
-            print(f"[lca] resuming {run_dir.path.name} at iteration {self.start}/{self.total}")
+        set_initial_stds(self.alg.get_policy(), cfg.actor, self.env.scene.joint_names)
+        self.stats = EpisodeStats(self.env.num_envs, self.env.device)
+        infos = self._load_newest_readable()
         self.rewards = RewardCurriculum(
             cfg.task.reward_curriculum, self.total, (infos or {}).get("penalty_scale")
         )
@@ -133,20 +111,88 @@ class Trainer:
     def perception_on(self, iteration: int) -> bool:
         return curriculum.perception_on(self.cfg.curriculum, iteration, self.total)
 
-    def save(self, name: str, iteration: int) -> Path:
+    def save(self, name: str, iteration: int, upload: bool = False) -> Path:
+        """Write checkpoints/<name> atomically (a uniquely named temporary file, then a
+        rename). `latest.pt`'s previous version is kept as `previous.pt`, the fallback of a
+        resume. `upload` registers the final path with the logger (wandb)."""
         self.run.checkpoints.mkdir(parents=True, exist_ok=True)
         self.runner.current_learning_iteration = iteration
+        saved = self.alg.save()
+        saved["iter"] = iteration
+        saved["infos"] = {
+            "stage": curriculum.stage_name(self.cfg.curriculum, iteration, self.total),
+            "penalty_scale": self.rewards.scale,
+        }
+        saved[LOOP_STATE] = self._loop_state()
         path = self.run.checkpoints / name
-        tmp = path.with_suffix(".tmp")
-        self.runner.save(
-            str(tmp),
-            infos={
-                "stage": curriculum.stage_name(self.cfg.curriculum, iteration, self.total),
-                "penalty_scale": self.rewards.scale,
-            },
-        )
-        tmp.replace(path)
+        fd, tmp = tempfile.mkstemp(dir=self.run.checkpoints, prefix=f".{name}.")
+        os.close(fd)
+        torch.save(saved, tmp)
+        if name == LATEST and path.exists():
+            os.replace(path, self.run.checkpoints / PREVIOUS)
+        os.replace(tmp, path)
+        if upload:
+            self.runner.logger.save_model(str(path), iteration)
         return path
+
+    def _loop_state(self) -> dict:
+        """What the loop carries across an iteration boundary besides the networks, so a
+        resumed run continues exactly as the uninterrupted one would."""
+        hidden = {}
+        for name in ("actor", "critic"):
+            model = getattr(self.alg, name)
+            if model.is_recurrent:
+                hidden[name] = _clone(model.rnn.hidden_state)
+        return {
+            "env": env_state(self.env),
+            "stats": self.stats.state_dict(),
+            "torch_rng": torch.get_rng_state(),
+            "cuda_rng": torch.cuda.get_rng_state_all() if torch.cuda.is_available() else None,
+            "hidden": hidden,
+        }
+
+    def _restore_loop_state(self, path: Path) -> None:
+        state = torch.load(path, map_location=self.device, weights_only=False).get(LOOP_STATE)
+        if state is None:  # a checkpoint from before exact resume: networks only
+            print(f"[lca] {path.name} holds no loop state: the environment starts afresh")
+            return
+        restore_env_state(self.env, state["env"])
+        self.stats.load_state_dict(state["stats"])
+        torch.set_rng_state(state["torch_rng"].cpu())
+        if state["cuda_rng"] is not None and torch.cuda.is_available():
+            torch.cuda.set_rng_state_all(state["cuda_rng"])
+        for name, hidden in state["hidden"].items():
+            getattr(self.alg, name).rnn.hidden_state = hidden
+
+    def _load_newest_readable(self) -> dict | None:
+        """Load the newest checkpoint that reads (latest, then previous), saying what was
+        skipped and why; None when there is none. Raises naming the files if none reads."""
+        candidates = [p for p in (LATEST, PREVIOUS) if (self.run.checkpoints / p).exists()]
+        errors = []
+        for name in candidates:
+            path = self.run.checkpoints / name
+            try:
+                infos = self.runner.load(str(path), map_location=self.device)
+            except Exception as error:  # a truncated or corrupt file
+                reason = str(error).splitlines()[0][:200]
+                print(f"[lca] skipping unreadable checkpoint {path}: {reason}")
+                errors.append(f"{path}: {reason}")
+                continue
+            # rsl-rl stores the index of the last finished iteration
+            self.start = self.runner.current_learning_iteration + 1
+            self._restore_loop_state(path)
+            print(
+                f"[lca] resuming {self.run.path.name} at iteration {self.start}/{self.total}"
+                f" (from {name})"
+            )
+            return infos or {}
+        if errors:
+            raise RuntimeError(
+                "no readable checkpoint to resume from: "
+                + "; ".join(errors)
+                + f". Delete {self.run.checkpoints} to start this run afresh (or force=true)."
+            )
+        return None
 
     def _curve_rows_before(self, iteration: int) -> list[dict]:
         """Curve rows of a resumed run up to its checkpoint (later rows are re-done)."""
@@ -155,21 +201,52 @@ class Trainer:
         with self.run.curve.open(newline="") as f:
             return [r for r in csv.DictReader(f) if int(r["iteration"]) < iteration]
 
+    def _check_finite(self, ends: np.ndarray, steps: int, it: int, streak: int) -> int:
+        """Fail loudly, instead of finishing as COMPLETE, when the policy's output is never
+        finite or when every episode of BROKEN_STREAK iterations in a row ends in a
+        non-finite physics state. Returns the updated streak."""
+        episodes, _, nonfinite, bad_actions = (int(x) for x in ends)
+        if bad_actions == steps:
+            raise RuntimeError(
+                f"iteration {it}: every action of the policy was NaN or inf; the networks "
+                "have diverged (lower algo.learning_rate, or check the observations)"
+            )
+        streak = streak + 1 if episodes > 0 and nonfinite == episodes else 0
+        if streak >= min(BROKEN_STREAK, self.total):
+            raise RuntimeError(
+                f"iterations {it - streak + 1}-{it}: every episode ended in a non-finite "
+                f"physics state ({nonfinite} of {episodes} in the last); the simulation is "
+                "unstable (check sim.timestep, sim.decimation and the robot's gains)"
+            )
+        return streak
+
+    def _rewrite_curve(self, rows: list[dict]) -> None:
+        self.run.path.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=self.run.path, prefix=f".{self.run.curve.name}.")
+        try:
+            with os.fdopen(fd, "w", newline="") as f:
+                writer = csv.DictWriter(f, fieldnames=CURVE_FIELDS, extrasaction="ignore")
+                writer.writeheader()
+                writer.writerows(rows)
+            os.replace(tmp, self.run.curve)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+
     def train(self, hook=None) -> dict:
         """Train to `scale.max_iterations`. `hook(trainer, iteration, row)`, if given, runs
         after every iteration outside the timed training (its time is not in `wall_s`) and
         may return True to stop training there."""
         cfg, env, alg = self.cfg, self.env, self.alg
         num_steps = int(cfg.algo.num_steps_per_env)
-        stats = EpisodeStats(env.num_envs, env.device)
+        stats = self.stats
         alg.train_mode()
         switch = curriculum.switch_iteration(cfg.curriculum, self.total)
         kept = self._curve_rows_before(self.start)
         self.last = {k: _number(v) for k, v in kept[-1].items()} if kept else {}
-        curve = self.run.curve.open("w", newline="")
-        writer = csv.DictWriter(curve, fieldnames=CURVE_FIELDS)
-        writer.writeheader()
-        writer.writerows(kept)
+        self._rewrite_curve(kept)  # atomically: the kept rows, or a fresh header
+        curve = self.run.curve.open("a", newline="")
+        writer = csv.DictWriter(curve, fieldnames=CURVE_FIELDS, extrasaction="ignore")
         env.set_perception(self.perception_on(self.start))
         obs = env.get_observations().to(self.device)
         t_start = time.perf_counter()
@@ -177,8 +254,8 @@ class Trainer:
             self.runner.logger.init_logging_writer()
             final = self._loop(writer, curve, stats, switch, obs, t_start, num_steps, hook)
             stage = curriculum.stage_name(cfg.curriculum, final, self.total)
-            self.save(f"final_{stage}.pt", final)
-            self.save("latest.pt", final)
+            self.save(f"final_{stage}.pt", final, upload=True)
+            self.save(LATEST, final)
         finally:
             curve.close()
             self.runner.logger.stop_logging_writer()  # wandb.finish() even on failure
@@ -189,20 +266,25 @@ class Trainer:
         cfg, env, alg = self.cfg, self.env, self.alg
         paused = 0.0  # seconds spent in the hook, kept out of wall_s
         wall_before = float(self.last.get("wall_s", 0.0))  # a resumed run's earlier time
+        broken_streak = 0
         actor = alg.get_policy()
         it = self.start - 1
         for it in range(self.start, self.total):
             if it == switch and it > 0 and not self.perception_on(it - 1):
-                self.save(f"stage1_blind_it{it - 1}.pt", it - 1)
+                self.save(f"stage1_blind_it{it - 1}.pt", it - 1, upload=True)
             if self.perception_on(it) != env.perception:
                 env.set_perception(self.perception_on(it))
                 obs = env.get_observations().to(self.device)
             length = self.last.get("mean_episode_length", math.nan)
-            self.rewards.update(it, float(length) / env.max_episode_length)
+            progress = self.last.get("tracking_progress", math.nan)
+            self.rewards.update(it, float(length) / env.max_episode_length, float(progress))
             env.set_reward_shaping(self.rewards.scale, self.rewards.only_positive)
             env.commands.min_speed = self.commands.floor(it)
-            apply_ceiling(actor, noise_ceiling(cfg.actor, it, self.total))
+            ceiling = noise_ceiling(cfg.actor, it, self.total, self.rewards.progress)
+            apply_ceiling(actor, ceiling)
             actor.kl_values = []
+            track_sums = np.zeros(2)  # |u - v| and |u| over moving commands
+            ends = np.zeros(4, dtype=np.int64)  # episodes ended, falls, non-finite, bad actions
             t0 = time.perf_counter()
             update_threads = torch.get_num_threads()
             if cfg.collect_threads > 0:
@@ -217,6 +299,18 @@ class Trainer:
                         dones.to(self.device),
                     )
                     alg.process_env_step(obs, rewards, dones, extras)
+                    m = extras["metrics"]
+                    ends += (
+                        int(dones.sum()),
+                        int(m["fell"].sum()),
+                        int(m["nonfinite"].sum()),
+                        int(m["nonfinite_action"].sum()),
+                    )
+                    moving = extras["metrics"]["command_speed"] >= MOVING
+                    track_sums += (
+                        extras["metrics"]["track_error"][moving].sum(),
+                        extras["metrics"]["command_speed"][moving].sum(),
+                    )
                     self.runner.logger.process_env_step(rewards, dones, extras)
                     stats.add(rewards, dones, extras.get("log", {}))
                 alg.compute_returns(obs)
@@ -255,22 +349,30 @@ class Trainer:
                 "kl": float(np.mean(kl)) if kl else math.nan,
                 "penalty_scale": self.rewards.scale,
                 "command_floor": env.commands.min_speed,
+                "falls": int(ends[1]),
+                "nonfinite": int(ends[2]),
+                "nonfinite_actions": int(ends[3]),
+                "tracking_progress": 1.0 - track_sums[0] / track_sums[1]
+                if track_sums[1] > 0
+                else math.nan,
                 **stats.summary(),
             }
             writer.writerow(row)
             curve.flush()
             self.last = row
+            broken_streak = self._check_finite(ends, num_steps * env.num_envs, it, broken_streak)
             if (it + 1) % cfg.scale.log_interval == 0 or it + 1 == self.total:
                 eta = elapsed / done_its * (self.total - it - 1)
                 print(
                     f"[lca] it {it + 1:>5}/{self.total} | {row['steps_per_s']:8,.0f} steps/s | "
                     f"reward {row['mean_reward']:8.2f} | ep len {row['mean_episode_length']:6.1f}"
+                    f" | falls {row['falls']} | non-finite {row['nonfinite']}"
                     f" | {row['stage']:<10} | penalties x{row['penalty_scale']:.2f}"
                     f" | lr {row['learning_rate']:.1e} | ETA {_fmt_eta(eta)}",
                     flush=True,
                 )
             if (it + 1) % cfg.scale.checkpoint_interval == 0:
-                self.save("latest.pt", it)
+                self.save(LATEST, it)
             if hook is not None:
                 t_hook = time.perf_counter()
                 stop = hook(self, it, row)

@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import os
+import shutil
+import tempfile
 from pathlib import Path
 
 import pandas as pd
 
-from lca.report.collect import find_run_dirs, load_run
+from lca.report.collect import find_run_dirs, load_run, run_status
 from lca.report.dashboard import hardware_section, write_dashboard
 from lca.report.figures import plot_rewards
 from lca.report.hardware_table import hardware_table
@@ -21,12 +24,46 @@ from lca.report.tables import (
 
 
 def build_report(paths: list[Path], out_dir: Path) -> Path:
-    """Tables (LaTeX, CSV), the training figure (PNG, PDF) and index.html into `out_dir`."""
+    """Tables (LaTeX, CSV), the training figure (PNG, PDF) and index.html into `out_dir`.
+
+    Only complete runs count; the others are listed apart with their status. The report is
+    built in a temporary folder and then swapped in, so an interrupted build never leaves a
+    half-written report."""
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    runs = [load_run(p) for p in find_run_dirs(paths)]
-    if not runs:
-        raise FileNotFoundError(f"no run directories under {[str(p) for p in paths]}")
+    found = find_run_dirs(paths)
+    status = {p: run_status(p) for p in found}
+    complete = [p for p in found if status[p][0] == "complete"]
+    if not complete:
+        listed = "; ".join(f"{p} ({status[p][0]})" for p in found) or "none"
+        raise FileNotFoundError(
+            f"no complete run directories under {[str(p) for p in paths]} (found: {listed})"
+        )
+    excluded = pd.DataFrame(
+        [
+            {"run": str(p), "status": status[p][0], "reason": status[p][1]}
+            for p in found
+            if p not in complete
+        ],
+        columns=["run", "status", "reason"],
+    )
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(dir=out_dir.parent, prefix=f".{out_dir.name}."))
+    try:
+        _build(complete, excluded, tmp, out_dir)
+        old = None
+        if out_dir.exists():
+            old = Path(tempfile.mkdtemp(dir=out_dir.parent, prefix=f".{out_dir.name}.old."))
+            os.replace(out_dir, old / "report")
+        os.replace(tmp, out_dir)
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return out_dir / "index.html"
+
+
+def _build(run_dirs: list[Path], excluded: pd.DataFrame, out_dir: Path, final: Path) -> None:
+    runs = [load_run(p) for p in run_dirs]
     episodes = pooled_episodes(runs)
     table = long_table(episodes) if not episodes.empty else episodes
     table.to_csv(out_dir / "sim_table.csv", index=False)
@@ -38,6 +75,7 @@ def build_report(paths: list[Path], out_dir: Path) -> Path:
         (out_dir / "sim_table.tex").write_text(to_latex(text, best))
     claim = claim_table(runs)
     claim.to_csv(out_dir / "claim.csv", index=False)
+    excluded.to_csv(out_dir / "excluded_runs.csv", index=False)
     plot_rewards(runs, out_dir / "training_rewards")
     hardware_html = ""
     trials = {}
@@ -49,4 +87,4 @@ def build_report(paths: list[Path], out_dir: Path) -> Path:
         hw_table.to_csv(out_dir / "hardware_table.csv", index=False)
         (out_dir / "hardware_table.tex").write_text(hw_latex)
         hardware_html = hardware_section(hw_table)
-    return write_dashboard(out_dir, runs, text, best, claim, hardware_html)
+    write_dashboard(out_dir, runs, text, best, claim, hardware_html, excluded, link_base=final)

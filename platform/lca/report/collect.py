@@ -72,6 +72,17 @@ def find_run_dirs(paths: list[Path]) -> list[Path]:
     return found
 
 
+def run_status(path: Path) -> tuple[str, str]:
+    """("complete" | "failed" | "incomplete", reason) of a run directory."""
+    if (path / "COMPLETE").exists():
+        return "complete", ""
+    failed = path / "FAILED"
+    if failed.exists():
+        reason = json.loads(failed.read_text())
+        return "failed", f"{reason.get('error')}: {reason.get('message', '')}"
+    return "incomplete", "no COMPLETE marker (still running, interrupted or never finished)"
+
+
 def load_run(path: Path) -> RunRecord:
     cfg = OmegaConf.load(path / "config.yaml")
     provenance = json.loads((path / "provenance.json").read_text())

@@ -38,6 +38,7 @@ random numbers), 95 % paired bootstrap CI. <a href="claim.csv">CSV</a>.</p>
 <img src="training_rewards.png" alt="training rewards">
 <h2 id="runs">Runs</h2>
 {{ runs_table }}
+{{ excluded }}
 </body></html>
 """
 )
@@ -98,9 +99,28 @@ def hardware_section(table: pd.DataFrame) -> str:
     )
 
 
+def excluded_section(excluded: pd.DataFrame | None) -> str:
+    if excluded is None or excluded.empty:
+        return ""
+    return (
+        '<h2 id="excluded">Runs left out</h2><p>Only complete runs count; these are not '
+        '(<a href="excluded_runs.csv">CSV</a>).</p>'
+        + excluded.to_html(index=False, table_id="excluded-table", escape=True)
+    )
+
+
 def write_dashboard(
-    out_dir: Path, runs, text, best, claim: pd.DataFrame, hardware: str = ""
+    out_dir: Path,
+    runs,
+    text,
+    best,
+    claim: pd.DataFrame,
+    hardware: str = "",
+    excluded: pd.DataFrame | None = None,
+    link_base: Path | None = None,
 ) -> Path:
+    """index.html in `out_dir`; run links are relative to `link_base` (default out_dir), the
+    folder the page will finally live in."""
     claim_html = (
         claim.round(3).to_html(index=False, table_id="claim-table")
         if not claim.empty
@@ -111,8 +131,9 @@ def write_dashboard(
         n_complete=sum(r.episodes is not None for r in runs),
         sim_table=sim_table_html(text, best),
         claim_table=claim_html,
-        runs_table=runs_table(runs, out_dir),
+        runs_table=runs_table(runs, Path(link_base or out_dir)),
         hardware=hardware,
+        excluded=excluded_section(excluded),
     )
     path = out_dir / "index.html"
     path.write_text(page)

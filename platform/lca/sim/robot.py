@@ -34,6 +34,11 @@ IMU_SITE = "imu_in_pelvis"
 UNDESIRED_CONTACT_BODIES = ("hip_roll_link", "hip_yaw_link", "knee_link")
 BASE_BODY = "pelvis"
 
+JOINT_GROUPS = {  # named joint sets (config keys that would be awkward regexes on a CLI)
+    "legs": r"(left|right)_(hip|knee|ankle)_.*",
+    "waist": r"waist_.*",
+    "arms": r"(left|right)_(shoulder|elbow|wrist)_.*",
+}
 COLLISION_PARTS = {
     "feet": r"(left|right)_foot_sphere\d+",
     "legs": r"(left|right)_(hip|thigh|shin|linkage_brace)_collision",

@@ -123,7 +123,8 @@ class LocomotionEnv(VecEnv):
         self.episode_sums: dict[str, np.ndarray] = {
             k: np.zeros(self.num_envs) for k in self.weights
         }
-        self.nonfinite_resets = 0
+        self.nonfinite_resets = 0  # envs reset from a non-finite state (actions included)
+        self.nonfinite_actions = 0  # env steps whose action held a NaN or inf
         self._push_steps = (
             int(round(task.randomization.push_interval_s / self.dt))
             if task.randomization.enabled
@@ -143,7 +144,9 @@ class LocomotionEnv(VecEnv):
     def step(self, actions: torch.Tensor) -> tuple[TensorDict, torch.Tensor, torch.Tensor, dict]:
         clip = self.task_cfg.action_clip
         self.last_action = self.action
-        self.action = np.clip(actions.detach().cpu().numpy().astype(np.float64), -clip, clip)
+        raw = actions.detach().cpu().numpy().astype(np.float64)
+        bad_action = ~np.isfinite(raw).all(axis=1)  # NaN / inf from the policy: counted, zeroed
+        self.action = np.clip(np.where(np.isfinite(raw), raw, 0.0), -clip, clip)
         self.sim.ctrl[:] = self.default_joint_pos + self.action_scale * self.action
         bad_before = ~np.isfinite(self.sim.qpos).all(1) | ~np.isfinite(self.sim.qvel).all(1)
         warnings_before = self._bad_state_warnings()
@@ -156,7 +159,7 @@ class LocomotionEnv(VecEnv):
         self.commands.update()
 
         state = read_state(self.sim, self.contacts)
-        broken = bad_before | (self._bad_state_warnings() > warnings_before)
+        broken = bad_before | bad_action | (self._bad_state_warnings() > warnings_before)
         broken |= non_finite(state, self.task_cfg.terminations.max_joint_vel)
         state = _sanitise(state, broken)
         fallen = fell(state, self.task_cfg.terminations) & ~broken
@@ -180,7 +183,12 @@ class LocomotionEnv(VecEnv):
         if done_ids.size:
             extras["log"] = self._episode_log(done_ids, fallen, time_out)
         self.nonfinite_resets += int(broken.sum())
+        self.nonfinite_actions += int(bad_action.sum())
         extras["log"]["Episode_Termination/nonfinite_total"] = float(self.nonfinite_resets)
+        extras["log"]["Episode_Termination/nonfinite_actions_total"] = float(self.nonfinite_actions)
+        extras["metrics"]["fell"] = fallen
+        extras["metrics"]["nonfinite"] = broken
+        extras["metrics"]["nonfinite_action"] = bad_action
         extras["log"]["Curriculum/penalty_scale"] = self.penalty_scale
         extras["log"]["Curriculum/only_positive"] = float(self.only_positive)
         extras["log"]["Curriculum/command_floor"] = self.commands.min_speed
@@ -313,6 +321,7 @@ class LocomotionEnv(VecEnv):
             "time_out": time_out.copy(),
             "lateral_impact": (state.foot_lateral_force > threshold).any(axis=1),
             "track_error": np.linalg.norm(error, axis=1),
+            "command_speed": np.linalg.norm(self.commands.value[:, :2], axis=1),
             "base_pos": state.base_pos.copy(),
         }
 

@@ -1,0 +1,88 @@
+"""Everything a `LocomotionEnv` carries from one step to the next, as a picklable dict.
+
+Saved with a training checkpoint, it makes a resumed run continue exactly where the killed
+one stopped: MuJoCo's integration state (qpos, qvel, warm start, ...; `mjSTATE_INTEGRATION`,
+enough for bit-identical stepping), the per-env model parameters drawn by domain
+randomisation, the task's buffers (histories, commands, clocks, actions, episode sums), the
+current observations, and the random generators' states.
+"""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import torch
+
+ARRAYS = ("_episode_steps", "action", "last_action")
+COUNTERS = ("nonfinite_resets", "nonfinite_actions", "penalty_scale", "only_positive")
+
+
+def env_state(env) -> dict:
+    sim = env.sim
+    state = {
+        "sim": sim.batch.bind("state").copy(),
+        "warning": env.warnings.copy(),
+        "friction": None if sim._friction is None else sim._friction.copy(),
+        "body_mass": None if sim._body_mass is None else sim._body_mass.copy(),
+        "history": env.history.buffer.copy(),
+        "critic_history": env.critic_history.buffer.copy(),
+        "commands": {
+            "value": env.commands.value.copy(),
+            "time_left": env.commands.time_left.copy(),
+            "min_speed": env.commands.min_speed,
+        },
+        "episode_sums": {k: v.copy() for k, v in env.episode_sums.items()},
+        "perception": env.perception,
+        "obs": {k: v.clone() for k, v in env._obs.items()},
+        "robot_state": copy.deepcopy(vars(env._state)),
+        "rng": env.rng.bit_generator.state,
+        "sim_rng": sim.rng.bit_generator.state,
+        "camera": None,
+    }
+    state |= {name: getattr(env, name).copy() for name in ARRAYS}
+    state |= {name: getattr(env, name) for name in COUNTERS}
+    if env.cameras is not None:
+        state["camera"] = {"frame": env._camera_frame.copy(), "map": env._deployment_map.copy()}
+    return state
+
+
+def restore_env_state(env, state: dict) -> None:
+    """Put `state` (from `env_state` of an env built from the same config) back."""
+    sim = env.sim
+    if state["sim"].shape != sim.batch.bind("state").shape:
+        raise ValueError(
+            f"saved env state is for {state['sim'].shape[0]} envs of state size "
+            f"{state['sim'].shape[1]}; this env has {sim.batch.bind('state').shape}"
+        )
+    sim.batch.bind("state")[:] = state["sim"]
+    env.warnings[:] = state["warning"]
+    if state["friction"] is not None:
+        sim.set_friction_scale(np.arange(env.num_envs), np.ones(env.num_envs))  # expand
+        sim._friction[:] = state["friction"]
+    if state["body_mass"] is not None:
+        sim._body_mass[:] = state["body_mass"]
+        sim.batch.set_const(np.arange(env.num_envs))
+    env.history.buffer[:] = state["history"]
+    env.critic_history.buffer[:] = state["critic_history"]
+    env.commands.value[:] = state["commands"]["value"]
+    env.commands.time_left[:] = state["commands"]["time_left"]
+    env.commands.min_speed = state["commands"]["min_speed"]
+    for name, sums in state["episode_sums"].items():
+        env.episode_sums[name][:] = sums
+    for name in ARRAYS:
+        getattr(env, name)[:] = state[name]
+    for name in COUNTERS:
+        setattr(env, name, state[name])
+    env.perception = state["perception"]
+    for key, value in state["obs"].items():
+        env._obs[key] = value.to(env.device)
+    for key, value in state["robot_state"].items():
+        setattr(env._state, key, value)
+    env.rng.bit_generator.state = state["rng"]
+    sim.rng.bit_generator.state = state["sim_rng"]
+    if state["camera"] is not None:
+        env._camera_frame[:] = state["camera"]["frame"]
+        env._deployment_map[:] = state["camera"]["map"]
+    env.episode_length_buf = torch.as_tensor(env._episode_steps, device=env.device)
+    sim.forward()  # derived quantities (sensors, contacts) from the restored state
