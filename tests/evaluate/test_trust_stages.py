@@ -93,6 +93,13 @@ def test_run_config_override_errors_name_the_key(tmp_path):
     [
         ["lca.describe", "scale=smoke", "difficulty=hard"],
         ["lca.scene", "scale=smoke", "terrain=flat", "out={tmp}/s.mjb"],
+        [
+            "lca.experiment",
+            "experiments/paper_sim.yaml",
+            "scale=smoke",
+            "difficulty=hard",
+            "--dry-run",
+        ],
     ],
 )
 def test_compose_entry_points_take_group_overrides(tmp_path, module):
@@ -165,3 +172,21 @@ def test_a_locked_run_directory_is_refused_by_evaluation(tmp_path):
         holder.kill()
         holder.wait()
     assert RunDir(run.path).failed is None
+
+
+def test_unreadable_final_checkpoint_names_the_file_and_the_way_out(tmp_path):
+    _, run = train_tiny_run(tmp_path / "run")
+    final = next((run.path / "checkpoints").glob("final_*.pt"))
+    final.write_bytes(final.read_bytes()[:1000])
+    done = subprocess.run(
+        [sys.executable, "-m", "lca.evaluate", f"run_dir={run.path}"],
+        cwd=tmp_path,
+        env=cli_env(),
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert done.returncode != 0
+    assert f"cannot read checkpoint {final}" in done.stderr
+    assert "force=true" in done.stderr

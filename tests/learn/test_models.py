@@ -4,6 +4,7 @@ policies (ONNX, TorchScript) against the torch policy."""
 from __future__ import annotations
 
 import copy
+import shutil
 
 import numpy as np
 import pytest
@@ -99,6 +100,7 @@ def exported(request, smoke_scene, tmp_path_factory) -> dict:
         "policy": trainer.alg.get_policy(),
         "num_actions": trainer.env.num_actions,
         "samples": [(obs["policy"][i : i + 1], obs["height"][i : i + 1]) for i in range(3)],
+        "batch": obs,
     }
 
 
@@ -123,7 +125,10 @@ def _onnx_actions(path, recurrent: bool, samples) -> tuple[list[str], list[np.nd
         if recurrent:
             if state is None:
                 shapes = {i.name: i.shape for i in sess.get_inputs()}
-                state = [np.zeros(shapes[k], dtype=np.float32) for k in ("h_in", "c_in")]
+                state = [  # the batch axis is symbolic: one sequence here
+                    np.zeros([d if isinstance(d, int) else 1 for d in shapes[k]], np.float32)
+                    for k in ("h_in", "c_in")
+                ]
             feed |= {"h_in": state[0], "c_in": state[1]}
             actions, h, c = sess.run(["actions", "h_out", "c_out"], feed)
             state = [h, c]
@@ -167,3 +172,31 @@ def test_exported_lstm_carries_state(exported) -> None:
     jit_alone = _jit_actions(exported["paths"]["torchscript"], samples[1:2])
     np.testing.assert_allclose(jit_alone[0], alone[0], atol=1e-4, rtol=0)
     np.testing.assert_allclose(jit_seq[1], seq[1], atol=1e-4, rtol=0)
+
+
+@pytest.mark.parametrize("batch", [1, 64])
+def test_onnx_is_one_file_with_a_dynamic_batch(exported, batch, tmp_path) -> None:
+    """policy.onnx copied alone loads, and takes a batch of any size."""
+    ort = pytest.importorskip("onnxruntime")
+    alone = tmp_path / "policy.onnx"
+    shutil.copyfile(exported["paths"]["onnx"], alone)
+    assert [p.name for p in tmp_path.iterdir()] == ["policy.onnx"]
+    sess = ort.InferenceSession(str(alone), providers=["CPUExecutionProvider"])
+    obs = exported["batch"]
+    index = torch.arange(batch) % obs.batch_size[0]
+    flat, height = obs["policy"][index], obs["height"][index]
+    flat = flat + 0.01 * torch.arange(batch)[:, None]  # distinct rows
+    feed = {"obs": flat.numpy(), "height": height.numpy()}
+    policy = exported["policy"]
+    policy.eval()
+    policy.reset()
+    with torch.no_grad():
+        expected = policy(TensorDict({"policy": flat, "height": height}, batch_size=[batch]))
+    if exported["actor"] == "lstm":
+        shapes = {i.name: i.shape for i in sess.get_inputs()}
+        layers, hidden = shapes["h_in"][0], shapes["h_in"][2]
+        zeros = np.zeros((layers, batch, hidden), dtype=np.float32)
+        feed |= {"h_in": zeros, "c_in": zeros}
+    actions = sess.run(["actions"], feed)[0]
+    assert actions.shape == (batch, exported["num_actions"])
+    np.testing.assert_allclose(actions, expected.numpy(), atol=1e-4, rtol=0)

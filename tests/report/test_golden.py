@@ -4,6 +4,7 @@ labelled from configs (never folder names), the paired claim, the training figur
 
 from __future__ import annotations
 
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -73,7 +74,10 @@ def test_latex_layout_and_best_cells(fixture_report: Path) -> None:
     """Paper layout: Blind first, blocks Medium then Hard, best per column and block in bold
     (higher success, lower contacts/step and tracking error; ties all bold)."""
     tex = (fixture_report / "sim_table.tex").read_text()
-    assert tex.startswith(r"\begin{table}") and r"\toprule" in tex and r"\bottomrule" in tex
+    assert tex.startswith(r"\begin{table*}") and r"\toprule" in tex and r"\bottomrule" in tex
+    assert r"\centering" in tex and r"\resizebox{\textwidth}" in tex
+    assert r"\cmidrule(lr){2-4}\cmidrule(lr){5-7}" in tex  # under Stairs and Uneven Terrain
+    assert "standard deviation across units" in tex
     for label in (*TERRAINS.values(), *METRICS.values()):
         assert label in tex
     blocks = _latex_rows(tex)
@@ -90,7 +94,13 @@ def test_latex_layout_and_best_cells(fixture_report: Path) -> None:
     assert bold["Hard difficulty"] == [[4], [], [0, 1, 2, 3, 5]]
     blind_medium = blocks["Medium difficulty"][0]
     assert blind_medium[1] == r"\textbf{100.00}"  # success: mean only
-    assert blind_medium[2] == r"0.80 $\pm$ 0.06"  # mean $\pm$ standard error
+    table = pd.read_csv(fixture_report / "sim_table.csv").set_index(
+        ["policy", "terrain", "difficulty", "metric"]
+    )
+    row = table.loc[("Blind", "stairs", "medium", "contacts_per_step")]
+    assert row["sd"] == pytest.approx(row["se"] * np.sqrt(row["n_units"]))
+    assert row["n_units"] > 1 and row["sd"] > row["se"]  # the spread, not the standard error
+    assert blind_medium[2] == rf"{row['mean']:.2f} $\pm$ {row['sd']:.2f}"  # mean $\pm$ SD
 
 
 def test_latex_compiles(fixture_report: Path, tmp_path: Path) -> None:
@@ -99,8 +109,8 @@ def test_latex_compiles(fixture_report: Path, tmp_path: Path) -> None:
         pytest.skip("pdflatex is not installed (TeX Live); cannot compile sim_table.tex")
     shutil.copy(fixture_report / "sim_table.tex", tmp_path / "sim_table.tex")
     (tmp_path / "doc.tex").write_text(
-        "\\documentclass{article}\n\\usepackage{booktabs}\n\\begin{document}\n"
-        "\\input{sim_table.tex}\n\\end{document}\n"
+        "\\documentclass{article}\n\\usepackage{booktabs}\n\\usepackage{graphicx}\n"
+        "\\begin{document}\n\\input{sim_table.tex}\n\\end{document}\n"
     )
     out = subprocess.run(
         [pdflatex, "-interaction=nonstopmode", "-halt-on-error", "doc.tex"],
@@ -113,6 +123,9 @@ def test_latex_compiles(fixture_report: Path, tmp_path: Path) -> None:
     assert out.returncode == 0, out.stdout[-3000:]
     assert (tmp_path / "doc.pdf").stat().st_size > 1000
     assert "Undefined control sequence" not in out.stdout
+    log = (tmp_path / "doc.log").read_text(errors="replace")
+    overfull = [float(m) for m in re.findall(r"Overfull \\hbox \(([\d.]+)pt too wide", log)]
+    assert all(w <= 1.0 for w in overfull), overfull
 
 
 def test_long_table_values(fixture_report: Path) -> None:
@@ -125,6 +138,7 @@ def test_long_table_values(fixture_report: Path) -> None:
         "metric",
         "n_seeds",
         "mean",
+        "sd",
         "se",
         "ci_low",
         "ci_high",

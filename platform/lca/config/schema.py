@@ -71,7 +71,7 @@ class RobotConfig:
     actuators: dict[str, ActuatorGroup] = field(default_factory=dict)
     home: dict[str, float] = field(default_factory=dict)  # joint name regex -> angle (rad)
     home_base_height: float = 0.0  # 0: computed so the feet rest on the ground
-    collision_parts: list[str] = field(default_factory=lambda: ["feet", "legs"])
+    collision_parts: list[str] = field(default_factory=lambda: ["feet", "legs", "torso", "arms"])
     self_collision: bool = False
     foot_friction: float = 1.0
     # Sole contact spheres in the ankle-roll frame (toes, heels); the sole is at z = -0.035.
@@ -472,16 +472,19 @@ class EncoderConfig:
     kind: str = "cnn"  # cnn | mlp
     hidden_dims: list[int] = field(default_factory=lambda: [256, 256])
     latent_dim: int = 32  # z_H
-    conv_channels: list[int] = field(default_factory=lambda: [16, 16])  # cnn only
+    conv_channels: list[int] = field(default_factory=lambda: [8, 16])  # cnn only
     kernel_size: int = 3
     stride: int = 1
-    pool: int = 2  # max-pool after each convolution (cnn only); 0 disables
+    pool: int = 0  # max-pool after each convolution (cnn only); 0: none (the paper's CNN)
 
     def check(self) -> None:
         _require(
             self.kind in ENCODER_KINDS,
             "encoder.kind",
             f"unknown '{self.kind}'; allowed: {ENCODER_KINDS}",
+        )
+        _require(
+            self.pool in (0, 2, 3), "encoder.pool", f"allowed: 0 (none), 2, 3; got {self.pool}"
         )
 
 

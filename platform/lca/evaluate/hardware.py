@@ -49,7 +49,8 @@ def run_trials(env: LocomotionEnv, policy, task: HardwareTask, steps: int) -> pd
         m = extras["metrics"]
         done_now = active & (m["base_pos"][:, 0] >= task.goal_x) & ~m["terminated"]
         success |= done_now
-        drift = np.where(done_now, np.abs(m["base_pos"][:, 1] - start_y), drift)
+        # the net lateral drift, signed: the table's precision removes a fixed bias
+        drift = np.where(done_now, m["base_pos"][:, 1] - start_y, drift)
         time_s = np.where(done_now, (step + 1) * env.dt, time_s)
         active &= ~(done_now | m["terminated"] | m["time_out"])
         policy.reset(dones.bool())

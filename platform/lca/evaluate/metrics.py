@@ -72,13 +72,16 @@ def _mean(x, axis=-1):
 
 
 def describe(values: np.ndarray, resamples: int, confidence: float, seed: int) -> dict:
-    """Mean, standard error and percentile-bootstrap CI of the mean of unit values."""
+    """Mean, standard deviation across units (the paper's +-), standard error and
+    percentile-bootstrap CI of the mean of unit values."""
     values = np.asarray(values, float)
     n = len(values)
     low, high = _ci((values,), _mean, resamples, confidence, seed)
+    sd = float(values.std(ddof=1)) if n > 1 else 0.0
     return {
         "mean": float(values.mean()),
-        "se": float(values.std(ddof=1) / np.sqrt(n)) if n > 1 else 0.0,
+        "sd": sd,  # the spread across units: the paper's +-
+        "se": sd / np.sqrt(n) if n > 1 else 0.0,
         "ci_low": low,
         "ci_high": high,
         "n_units": n,

@@ -59,6 +59,16 @@ def versions() -> dict:
     return found
 
 
+def departures(cfg: DictConfig) -> list[str]:
+    """Settings of this run that are not the paper's, for anyone reading its numbers."""
+    out = []
+    if cfg.encoder.kind == "cnn" and int(cfg.encoder.pool) > 1:
+        out.append(f"encoder.pool={cfg.encoder.pool}: CNN with max-pooling (rows: CNN (pooled))")
+    if cfg.scale.name != "paper":
+        out.append(f"scale={cfg.scale.name}: fewer environments and iterations than the paper")
+    return out
+
+
 class RunLockedError(RuntimeError):
     """Another live process owns the run directory."""
 
@@ -171,6 +181,7 @@ class RunDir:
             "host": socket.gethostname(),
             "argv": sys.argv,
             "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+            "departures_from_paper": departures(cfg),
         }
         atomic_write(self.path / "provenance.json", json.dumps(provenance, indent=2))
 

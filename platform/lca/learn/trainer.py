@@ -27,6 +27,7 @@ from lca.learn import curriculum
 from lca.learn.command_curriculum import CommandCurriculum
 from lca.learn.episode_stats import EpisodeStats
 from lca.learn.exploration import apply_ceiling, noise_ceiling, set_initial_stds
+from lca.learn.export import export_jit, export_onnx
 from lca.learn.reward_curriculum import RewardCurriculum
 from lca.learn.rundir import RunDir
 from lca.learn.train_cfg import build_train_cfg
@@ -98,6 +99,9 @@ class Trainer:
         with contextlib.redirect_stdout(io.StringIO()):  # rsl-rl prints the model summaries
             self.runner = OnPolicyRunner(self.env, train_cfg, log_dir=log_dir, device=self.device)
         self.alg = self.runner.alg
+        # provenance.json records the code state; rsl-rl's own git probe of its installed
+        # package only prints "Could not find git repository"
+        self.runner.logger.git_status_repos = []
         self.start = 0
         set_initial_stds(self.alg.get_policy(), cfg.actor, self.env.scene.joint_names)
         self.stats = EpisodeStats(self.env.num_envs, self.env.device)
@@ -383,20 +387,8 @@ class Trainer:
         return it
 
     def export(self) -> dict[str, Path]:
-        self.run.exported.mkdir(parents=True, exist_ok=True)
-        with contextlib.redirect_stdout(io.StringIO()), warnings_quiet():
-            self.runner.export_policy_to_onnx(str(self.run.exported), "policy.onnx")
-            self.runner.export_policy_to_jit(str(self.run.exported), "policy.pt")
+        actor = self.alg.get_policy()
         return {
-            "onnx": self.run.exported / "policy.onnx",
-            "torchscript": self.run.exported / "policy.pt",
+            "onnx": export_onnx(actor, self.run.exported / "policy.onnx"),
+            "torchscript": export_jit(actor, self.run.exported / "policy.pt"),
         }
-
-
-@contextlib.contextmanager
-def warnings_quiet():
-    import warnings
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        yield

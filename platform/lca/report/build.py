@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from lca.report.collect import find_run_dirs, load_run, run_status
+from lca.report.collect import POOLED, find_run_dirs, load_run, run_status
 from lca.report.dashboard import hardware_section, write_dashboard
 from lca.report.figures import plot_rewards
 from lca.report.hardware_table import hardware_table
@@ -62,19 +62,33 @@ def build_report(paths: list[Path], out_dir: Path) -> Path:
     return out_dir / "index.html"
 
 
+SMOKE_NOTE = "smoke scale - not results"  # scale=smoke runs only check that things run
+
+
+def _mark(frame: pd.DataFrame, note: str) -> pd.DataFrame:
+    return frame.assign(note=note) if note else frame
+
+
 def _build(run_dirs: list[Path], excluded: pd.DataFrame, out_dir: Path, final: Path) -> None:
     runs = [load_run(p) for p in run_dirs]
+    note = SMOKE_NOTE if any(r.scale == "smoke" for r in runs) else ""
     episodes = pooled_episodes(runs)
     table = long_table(episodes) if not episodes.empty else episodes
-    table.to_csv(out_dir / "sim_table.csv", index=False)
+    _mark(table, note).to_csv(out_dir / "sim_table.csv", index=False)
     if table.empty:
         text = best = table
     else:
         text, means = wide_table(table)
         best = best_mask(means)
-        (out_dir / "sim_table.tex").write_text(to_latex(text, best))
+        notes = [f"\\textbf{{{note.replace(' - ', ' --- ')}.}}"] if note else []
+        if any(r.label.endswith(POOLED) for r in runs):
+            notes.append(
+                "CNN (pooled): $2\\times2$ max-pooling after each convolution "
+                "(\\texttt{encoder.pool}), not the paper's CNN."
+            )
+        (out_dir / "sim_table.tex").write_text(to_latex(text, best, " ".join(notes)))
     claim = claim_table(runs)
-    claim.to_csv(out_dir / "claim.csv", index=False)
+    _mark(claim, note).to_csv(out_dir / "claim.csv", index=False)
     excluded.to_csv(out_dir / "excluded_runs.csv", index=False)
     plot_rewards(runs, out_dir / "training_rewards")
     hardware_html = ""
@@ -84,7 +98,9 @@ def _build(run_dirs: list[Path], excluded: pd.DataFrame, out_dir: Path, final: P
             trials[run.label] = pd.concat([trials.get(run.label), run.hardware])
     if trials:
         hw_table, hw_latex = hardware_table(trials)
-        hw_table.to_csv(out_dir / "hardware_table.csv", index=False)
+        _mark(hw_table, note).to_csv(out_dir / "hardware_table.csv", index=False)
         (out_dir / "hardware_table.tex").write_text(hw_latex)
         hardware_html = hardware_section(hw_table)
-    write_dashboard(out_dir, runs, text, best, claim, hardware_html, excluded, link_base=final)
+    write_dashboard(
+        out_dir, runs, text, best, claim, hardware_html, excluded, link_base=final, note=note
+    )

@@ -21,22 +21,28 @@ ROW_ORDER = [
 STAGES = {"one": "One-Stage", "two": "Two-Stage"}
 
 
-def policy_label(curriculum: str, actor: str, encoder: str) -> str:
+POOLED = " (pooled)"  # a CNN with max-pooling is not the paper's CNN
+
+
+def policy_label(curriculum: str, actor: str, encoder: str, pool: int = 0) -> str:
     """The paper's row name, from the run's composed config (never from folder names).
 
     MLP = MLP actor + MLP encoder, CNN = MLP actor + CNN encoder, LSTM = LSTM actor
-    (+ MLP encoder; with a CNN encoder it is reported as LSTM-CNN)."""
+    (+ MLP encoder; with a CNN encoder it is reported as LSTM-CNN). A CNN encoder with
+    max-pooling (`encoder.pool`) reads "CNN (pooled)"."""
     if curriculum == "blind":
         return "Blind"
     if actor == "lstm":
         arch = "LSTM" if encoder == "mlp" else "LSTM-CNN"
     else:
         arch = "CNN" if encoder == "cnn" else "MLP"
-    return f"{STAGES.get(curriculum, curriculum)} {arch}"
+    pooled = POOLED if encoder == "cnn" and pool > 1 else ""
+    return f"{STAGES.get(curriculum, curriculum)} {arch}{pooled}"
 
 
 def row_key(label: str) -> tuple[int, str]:
-    return (ROW_ORDER.index(label) if label in ROW_ORDER else len(ROW_ORDER), label)
+    base = label.removesuffix(POOLED)
+    return (ROW_ORDER.index(base) if base in ROW_ORDER else len(ROW_ORDER), label)
 
 
 @dataclass
@@ -51,6 +57,7 @@ class RunRecord:
     episodes: pd.DataFrame | None
     curve: pd.DataFrame | None
     hardware: pd.DataFrame | None = None
+    scale: str = "cpu"
 
     @property
     def name(self) -> str:
@@ -91,7 +98,9 @@ def load_run(path: Path) -> RunRecord:
     hardware = path / "hardware.csv"
     return RunRecord(
         path=path,
-        label=policy_label(cfg.curriculum.name, cfg.actor.kind, cfg.encoder.kind),
+        label=policy_label(
+            cfg.curriculum.name, cfg.actor.kind, cfg.encoder.kind, int(cfg.encoder.get("pool", 0))
+        ),
         curriculum=cfg.curriculum.name,
         actor=cfg.actor.kind,
         encoder=cfg.encoder.kind,
@@ -100,4 +109,5 @@ def load_run(path: Path) -> RunRecord:
         episodes=pd.read_parquet(results) if results.exists() else None,
         curve=pd.read_csv(curve) if curve.exists() else None,
         hardware=pd.read_csv(hardware) if hardware.exists() else None,
+        scale=str(cfg.scale.name),
     )

@@ -22,8 +22,11 @@ PAGE = Template(
  td.best { font-weight: bold; }
  img { max-width: 100%; }
  code { background: #f4f4f4; padding: 1px 4px; }
+ p.note { background: #fde68a; padding: 0.6em 1em; font-weight: bold; }
 </style></head><body>
 <h1>lca: architecture ablations for humanoid locomotion</h1>
+{% if note %}<p id="note" class="note">{{ note }}: these runs only check that the pipeline
+works; their numbers are not results.</p>{% endif %}
 <p>{{ n_runs }} run(s), {{ n_complete }} with evaluation results.</p>
 <h2 id="simulation">Simulation results</h2>
 <p>Mean ± standard error over units (all seeds pooled); best per column and difficulty in bold.
@@ -89,12 +92,15 @@ def sim_table_html(text: pd.DataFrame, best: pd.DataFrame) -> str:
 def hardware_section(table: pd.DataFrame) -> str:
     shown = table.assign(
         success=table.successes.astype(str) + "/" + table.trials.astype(str),
-        drift_m=table.drift_m.round(3),
-    )[["policy", "task", "success", "drift_m"]]
+        track_m=table.track_mad_m.map(lambda v: "--" if pd.isna(v) else f"{v:.3f}"),
+        mean_abs_drift_m=table.mean_abs_drift_m.round(3),
+    )[["policy", "task", "success", "track_m", "mean_abs_drift_m"]]
     return (
         '<h2 id="hardware">Hardware-style tasks (simulation)</h2>\n'
-        "<p>Success over trials and mean lateral drift of the successful trials. "
-        '<a href="hardware_table.tex">LaTeX</a>, <a href="hardware_table.csv">CSV</a>.</p>\n'
+        "<p>Success over trials; Track (m): the mean absolute deviation of the net lateral "
+        "drift across the successful trials (the paper's precision), with the mean |drift| "
+        'beside it. <a href="hardware_table.tex">LaTeX</a>, '
+        '<a href="hardware_table.csv">CSV</a>.</p>\n'
         + shown.to_html(index=False, table_id="hardware-table")
     )
 
@@ -118,6 +124,7 @@ def write_dashboard(
     hardware: str = "",
     excluded: pd.DataFrame | None = None,
     link_base: Path | None = None,
+    note: str = "",
 ) -> Path:
     """index.html in `out_dir`; run links are relative to `link_base` (default out_dir), the
     folder the page will finally live in."""
@@ -134,6 +141,7 @@ def write_dashboard(
         runs_table=runs_table(runs, Path(link_base or out_dir)),
         hardware=hardware,
         excluded=excluded_section(excluded),
+        note=note,
     )
     path = out_dir / "index.html"
     path.write_text(page)

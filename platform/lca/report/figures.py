@@ -47,8 +47,19 @@ def plot_rewards(runs: list[RunRecord], out_stem: Path) -> list[Path]:
     ax.set_ylabel("mean episode return")
     ax.set_title("Training rewards")
     ax.grid(alpha=0.3)
-    if curves:
+    if curves and any(c["mean"].notna().any() for c in curves.values()):
         ax.legend(fontsize=8, frameon=False)
+    else:  # e.g. a few smoke iterations: no episode ended, so there is no return to plot
+        ax.text(
+            0.5,
+            0.5,
+            "no finished episode yet:\nno episode return to plot",
+            transform=ax.transAxes,
+            ha="center",
+            va="center",
+            fontsize=11,
+            color="0.4",
+        )
     fig.tight_layout()
     paths = [out_stem.with_suffix(".png"), out_stem.with_suffix(".pdf")]
     for path in paths:

@@ -61,8 +61,8 @@ def long_table(episodes: pd.DataFrame) -> pd.DataFrame:
     return table.assign(_o=order).sort_values(["_o", "difficulty", "terrain"]).drop(columns="_o")
 
 
-def _cell_text(mean: float, se: float, metric: str) -> str:
-    return f"{mean:.2f}" if metric == "success" else f"{mean:.2f} $\\pm$ {se:.2f}"
+def _cell_text(mean: float, sd: float, metric: str) -> str:
+    return f"{mean:.2f}" if metric == "success" else f"{mean:.2f} $\\pm$ {sd:.2f}"
 
 
 def wide_table(table: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
@@ -80,7 +80,7 @@ def wide_table(table: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
             continue
         key = (DIFFICULTIES[row.difficulty], row.policy)
         col = (TERRAINS[row.terrain], METRICS[row.metric])
-        text.loc[key, col] = _cell_text(row.mean, row.se, row.metric)
+        text.loc[key, col] = _cell_text(row.mean, row.sd, row.metric)
         means.loc[key, col] = row.mean
     return text, means
 
@@ -102,23 +102,30 @@ def best_mask(means: pd.DataFrame) -> pd.DataFrame:
     return mask
 
 
-def to_latex(text: pd.DataFrame, best: pd.DataFrame) -> str:
+def to_latex(text: pd.DataFrame, best: pd.DataFrame, note: str = "") -> str:
     """Booktabs LaTeX via pandas Styler, best cells bold, difficulty blocks introduced by an
-    italic row as in the paper (no packages beyond booktabs)."""
+    italic row as in the paper, `\\cmidrule` under the terrain headers, centred and scaled
+    to the text width (a `table*` in a two-column paper; needs booktabs and graphicx)."""
     styled = text.style.apply(
         lambda col: np.where(best[col.name], "textbf:--rwrap;", ""), axis=0
     ).hide(axis="index", level=0)
+    caption = (
+        "Simulation results: success rate ($\\uparrow$), contacts per step ($\\downarrow$), "
+        "tracking error ($\\downarrow$); mean $\\pm$ standard deviation across units."
+    )
     latex = styled.to_latex(
         hrules=True,
         multicol_align="c",
         column_format="l" + "c" * text.shape[1],
-        caption="Simulation results: success rate ($\\uparrow$), contacts per step "
-        "($\\downarrow$), tracking error ($\\downarrow$); mean $\\pm$ standard error over units.",
+        caption=caption + (f" {note}" if note else ""),
         label="tab:sim_results",
         position="t",
+        environment="table*",
     )
     lines = latex.splitlines()
     first_row = lines.index("\\midrule") + 1
+    lines = _group_rules(lines, text)
+    first_row += 1
     blocks = text.index.get_level_values(0)
     starts = {i: b for i, b in enumerate(blocks) if i == 0 or blocks[i - 1] != b}
     width = text.shape[1] + 1
@@ -130,7 +137,28 @@ def to_latex(text: pd.DataFrame, best: pd.DataFrame) -> str:
             out.append(f"\\multicolumn{{{width}}}{{l}}{{\\textit{{{starts[i]}}}}} \\\\")
         out.append(line)
     out += lines[first_row + len(text) :]
-    return "\n".join(out) + "\n"
+    return _fit_to_width("\n".join(out) + "\n")
+
+
+def _group_rules(lines: list[str], text: pd.DataFrame) -> list[str]:
+    """A `\\cmidrule(lr)` under each terrain's header, spanning its metric columns."""
+    groups = text.columns.get_level_values(0)
+    spans, start = [], 0
+    for i in range(1, len(groups) + 1):
+        if i == len(groups) or groups[i] != groups[start]:
+            spans.append((start + 2, i + 1))  # LaTeX columns: the policy column is 1
+            start = i
+    header = next(i for i, line in enumerate(lines) if "\\multicolumn" in line)
+    rule = "".join(f"\\cmidrule(lr){{{a}-{b}}}" for a, b in spans)
+    return lines[: header + 1] + [rule] + lines[header + 1 :]
+
+
+def _fit_to_width(latex: str) -> str:
+    """Centre the tabular and scale it to the text width, as the paper does."""
+    latex = latex.replace(
+        "\\begin{tabular}", "\\centering\n\\resizebox{\\textwidth}{!}{%\n\\begin{tabular}", 1
+    )
+    return latex.replace("\\end{tabular}", "\\end{tabular}%\n}", 1)
 
 
 def claim_table(runs: list[RunRecord]) -> pd.DataFrame:

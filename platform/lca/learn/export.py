@@ -1,0 +1,64 @@
+"""Deployable exports of a trained actor: one self-contained ONNX file with a dynamic batch,
+and TorchScript.
+
+ONNX inputs: `obs` (batch, D) and the heightmap (batch, 1, H, W); an LSTM actor also takes
+and returns its state, `h_in`/`c_in` -> `h_out`/`c_out` of shape (layers, batch, hidden).
+The weights live inside the .onnx file (TorchScript-based exporter), so the file can be
+copied alone.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import warnings
+from pathlib import Path
+
+import torch
+from torch import nn
+
+ONNX_OPSET = 17
+
+
+def _dynamic_axes(module: nn.Module) -> dict[str, dict[int, str]]:
+    axes = {name: {0: "batch"} for name in module.input_names[:2] + module.output_names[:1]}
+    if module.is_recurrent:
+        axes |= {name: {1: "batch"} for name in ("h_in", "c_in", "h_out", "c_out")}
+    return axes
+
+
+def export_onnx(actor, path: Path) -> Path:
+    """Write the actor's deterministic policy to `path` atomically."""
+    module = actor.as_onnx().to("cpu").eval()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
+    os.close(fd)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the legacy exporter's deprecation notice
+        torch.onnx.export(
+            module,
+            module.get_dummy_inputs(),
+            tmp,
+            input_names=module.input_names,
+            output_names=module.output_names,
+            dynamic_axes=_dynamic_axes(module),
+            opset_version=ONNX_OPSET,
+            dynamo=False,
+        )
+    os.replace(tmp, path)
+    return path
+
+
+def export_jit(actor, path: Path) -> Path:
+    """TorchScript of the actor (an LSTM keeps its state inside; `reset()` clears it)."""
+    module = actor.as_jit().to("cpu").eval()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
+    os.close(fd)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # torch.jit.script's deprecation notice
+        torch.jit.save(torch.jit.script(module), tmp)
+    os.replace(tmp, path)
+    return path
