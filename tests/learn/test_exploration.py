@@ -19,6 +19,14 @@ def test_ceiling_falls_linearly_to_the_final_std_and_holds():
     assert noise_ceiling(ActorConfig(), 5, 20) is None  # off by default: rsl-rl's free std
 
 
+def test_ceiling_holds_until_noise_start():
+    cfg = ActorConfig(init_noise_std=1.0, final_noise_std=0.4, noise_start=0.25, noise_deadline=0.5)
+    ceilings = [noise_ceiling(cfg, it, 20) for it in range(20)]
+    assert ceilings[:6] == [1.0] * 6
+    np.testing.assert_allclose(ceilings[5:11], 1.0 - 0.6 * np.arange(6) / 5)
+    assert ceilings[10:] == pytest.approx([0.4] * 10)
+
+
 def test_training_std_stays_under_the_ceiling(tmp_path, smoke_scene):
     cfg = smoke_cfg(
         "scale.max_iterations=4", "actor.final_noise_std=0.5", "actor.noise_deadline=0.5"

@@ -37,6 +37,24 @@ def test_scale_is_exactly_one_from_the_deadline_whatever_the_episodes():
     assert c.done and not c.only_positive
 
 
+def test_hold_caps_the_length_ramp_then_releases_it_linearly_to_one():
+    cfg = RewardCurriculumConfig(
+        enabled=True,
+        penalty_start=0.1,
+        length_start=0.0,
+        length_end=0.5,
+        deadline=0.8,
+        hold=0.6,
+        hold_until=0.4,
+    )
+    c = RewardCurriculum(cfg, total_iterations=10)
+    scales = [c.update(it, 1.0) for it in range(10)]  # episodes long from the start
+    assert scales[:5] == [0.6] * 5  # held, however long the episodes
+    assert scales[5:8] == pytest.approx([0.7, 0.8, 0.9])  # 0.6 -> 1 over iterations 4..8
+    assert scales[8:] == [1.0, 1.0]  # exactly the paper's weights from the deadline
+    assert c.done
+
+
 def test_only_positive_is_an_early_stage_only():
     cfg = RewardCurriculumConfig(enabled=True, only_positive=True, deadline=0.5)
     c = RewardCurriculum(cfg, total_iterations=4)

@@ -247,6 +247,11 @@ class RewardCurriculumConfig:
     length_end: float = 0.8  # ... and reaches the paper's weights at this one
     deadline: float = 0.75  # fraction of max_iterations from which the weights are the paper's
     only_positive: bool = False  # legged_gym's clip of the step's sum at 0 while scale < 1
+    # the length- or tracking-driven scale stops at `hold` (1: no hold); from `hold_until` x
+    # max_iterations it rises linearly to 1 at the deadline, so a gait found under light
+    # penalties gets time to settle before the table's weights arrive
+    hold: float = 1.0
+    hold_until: float = 0.5
     # terms scaled (their negative contributions); empty: every term, termination included
     terms: list[str] = field(default_factory=list)
 
@@ -260,6 +265,12 @@ class RewardCurriculumConfig:
         )
         _require(0 <= self.deadline <= 1, f"{key}.deadline", "must be in [0, 1]")
         _require(0 < self.ramp <= 1, f"{key}.ramp", "must be in (0, 1]")
+        _require(0 < self.hold <= 1, f"{key}.hold", "must be in (0, 1]")
+        _require(
+            self.hold >= 1 or 0 <= self.hold_until < self.deadline,
+            f"{key}.hold_until",
+            f"need 0 <= hold_until < deadline, got {self.hold_until}, {self.deadline}",
+        )
         allowed = ("episode_length", "iterations", "tracking")
         _require(self.by in allowed, f"{key}.by", f"unknown '{self.by}'; allowed: {allowed}")
         from lca.task.rewards import REWARD_TERMS  # task layer owns the names
@@ -447,6 +458,7 @@ class ActorConfig:
     # precisely once the penalties are the paper's. 0: rsl-rl's free, learned std.
     final_noise_std: float = 0.0
     noise_deadline: float = 0.6
+    noise_start: float = 0.0  # iterations: the ceiling stays at init_noise_std until here
     # what lowers the ceiling: the iteration (to noise_deadline) or the reward curriculum's
     # progress (the ceiling reaches final_noise_std as the penalties reach the paper's)
     noise_by: str = "iterations"
@@ -462,6 +474,11 @@ class ActorConfig:
             f"must be in [0, init_noise_std={self.init_noise_std}], got {self.final_noise_std}",
         )
         _require(0 <= self.noise_deadline <= 1, "actor.noise_deadline", "must be in [0, 1]")
+        _require(
+            0 <= self.noise_start < max(self.noise_deadline, 1e-9) or self.noise_start == 0,
+            "actor.noise_start",
+            f"need 0 <= noise_start < noise_deadline, got {self.noise_start}",
+        )
         allowed = ("iterations", "penalties")
         _require(self.noise_by in allowed, "actor.noise_by", f"allowed: {allowed}")
 

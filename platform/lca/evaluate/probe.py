@@ -28,6 +28,7 @@ PROBE_FIELDS = (
     "env_steps",
     "train_wall_s",
     "penalty_scale",
+    "paper_objective",
     "success",
     "track_cm_s",
     "contacts_per_step",

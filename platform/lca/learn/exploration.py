@@ -2,8 +2,9 @@
 
 A wide Gaussian finds stepping (a robot that is shaken must step to stay up); the same noise
 makes every gait sloppy and costly once the penalties are the paper's. The ceiling falls
-linearly from the initial std to `final_noise_std` at `noise_deadline` x max_iterations and
-stays there; below it the std is rsl-rl's learned parameter.
+linearly from the initial std (held until `noise_start` x max_iterations) to `final_noise_std`
+at `noise_deadline` x max_iterations and stays there; below it the std is rsl-rl's learned
+parameter.
 """
 
 from __future__ import annotations
@@ -26,7 +27,8 @@ def noise_ceiling(
     if cfg.final_noise_std <= 0:
         return None
     end = max(math.ceil(cfg.noise_deadline * total_iterations), 1)
-    progress = min(iteration / end, 1.0)
+    start = min(math.ceil(cfg.noise_start * total_iterations), end - 1)
+    progress = min(max(iteration - start, 0) / (end - start), 1.0)
     if cfg.noise_by == "penalties":
         progress = 1.0 if iteration >= end else float(penalty_progress)
     return cfg.init_noise_std + (cfg.final_noise_std - cfg.init_noise_std) * progress

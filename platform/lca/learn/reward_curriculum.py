@@ -22,6 +22,7 @@ class RewardCurriculum:
         self, cfg: RewardCurriculumConfig, total_iterations: int, scale: float | None = None
     ):
         self.cfg = cfg
+        self.total = total_iterations
         self.deadline = math.ceil(cfg.deadline * total_iterations) if cfg.enabled else 0
         self.step = (1.0 - cfg.penalty_start) / max(cfg.ramp * total_iterations, 1.0)
         start = cfg.penalty_start if cfg.enabled else 1.0
@@ -49,10 +50,20 @@ class RewardCurriculum:
             self.scale = 1.0
         elif c.by == "tracking":
             if episode_fraction >= c.length_start and tracking >= c.gate:
-                self.scale = min(1.0, self.scale + self.step)
+                self.scale = max(self.scale, min(c.hold, self.scale + self.step))
         else:
-            self.scale = max(self.scale, self.target(iteration, episode_fraction))
-        return self.scale
+            self.scale = max(self.scale, min(c.hold, self.target(iteration, episode_fraction)))
+        if c.enabled and c.hold < 1.0:
+            self.scale = max(self.scale, self.release(iteration))
+        return min(self.scale, 1.0)
+
+    def release(self, iteration: int) -> float:
+        """The held scale's ramp: `hold` until hold_until x max_iterations, then linear to 1
+        at the deadline."""
+        c = self.cfg
+        start = min(math.ceil(c.hold_until * self.total), self.deadline - 1)
+        progress = np.clip((iteration - start) / max(self.deadline - start, 1), 0.0, 1.0)
+        return float(c.hold + (1.0 - c.hold) * progress) if iteration > start else 0.0
 
     @property
     def only_positive(self) -> bool:
