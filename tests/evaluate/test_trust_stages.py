@@ -103,14 +103,17 @@ def test_run_config_override_errors_name_the_key(tmp_path):
     ],
 )
 def test_compose_entry_points_take_group_overrides(tmp_path, module):
-    args = [a.replace("{tmp}", str(tmp_path)) for a in module]
+    _run_module([a.replace("{tmp}", str(tmp_path)) for a in module], REPO, timeout=120)
+
+
+def _run_module(args: list[str], cwd, timeout: int) -> None:
     done = subprocess.run(
         [sys.executable, "-m", *args],
-        cwd=REPO,
+        cwd=cwd,
         env=cli_env(),
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=timeout,
         check=False,
     )
     assert done.returncode == 0, done.stderr[-2000:]
@@ -136,16 +139,7 @@ def test_stage_entry_points_take_group_overrides(tmp_path):
             "hardware.tasks=[stair_ascent]",
         ],
     ):
-        done = subprocess.run(
-            [sys.executable, "-m", *command],
-            cwd=tmp_path,
-            env=cli_env(),
-            capture_output=True,
-            text=True,
-            timeout=300,
-            check=False,
-        )
-        assert done.returncode == 0, done.stderr[-2000:]
+        _run_module(command, tmp_path, timeout=300)
 
 
 def test_a_locked_run_directory_is_refused_by_evaluation(tmp_path):

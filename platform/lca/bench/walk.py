@@ -1,7 +1,7 @@
 """Time-to-walk: train a blind MLP on flat ground from scratch at `scale=cpu` until it walks.
 
     python -m lca.bench walk [--json] [overrides] [cap_s=10800] [eval_every_s=240]
-        [iterations=1500] [run=runs/bench_walk] [resume=false] [stop=true]
+        [iterations=1500] [until=0] [run=runs/bench_walk] [resume=false] [stop=true]
 
 Every `eval_every_s` of training wall-clock the current policy is evaluated in-process with
 the paper's protocol on a flat cell (forward commands 0.3-0.6 m/s, 1000-step episodes,
@@ -44,6 +44,7 @@ OPTIONS = {
     "cap_s": 3 * 3600.0,
     "eval_every_s": 240.0,
     "iterations": 1500,
+    "until": 0,  # stop after this many iterations (0: none), the schedule still `iterations` long
     "run": "runs/bench_walk",
     "resume": "false",
     "stop": "true",
@@ -95,6 +96,7 @@ def run(args: list[str], log: Callable[[str], None] | None = print) -> dict:
     def hook(trainer: Trainer, it: int, row: dict) -> bool:
         wall = float(row["wall_s"])
         last = it + 1 == trainer.total or wall >= opts["cap_s"]
+        last = last or 0 < opts["until"] <= it + 1
         if wall < state["next"] and not last:
             return False
         state["next"] = wall + opts["eval_every_s"]

@@ -27,16 +27,25 @@ def _dynamic_axes(module: nn.Module) -> dict[str, dict[int, str]]:
     return axes
 
 
-def export_onnx(actor, path: Path) -> Path:
-    """Write the actor's deterministic policy to `path` atomically."""
-    module = actor.as_onnx().to("cpu").eval()
+def _write_atomically(path: Path, write) -> Path:
+    """`write(tmp)` into a unique temporary file beside `path`, then rename it to `path`."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
     os.close(fd)
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # the legacy exporter's deprecation notice
-        torch.onnx.export(
+        warnings.simplefilter("ignore")  # the exporters' deprecation notices
+        write(tmp)
+    os.replace(tmp, path)
+    return path
+
+
+def export_onnx(actor, path: Path) -> Path:
+    """Write the actor's deterministic policy to `path` atomically."""
+    module = actor.as_onnx().to("cpu").eval()
+    return _write_atomically(
+        path,
+        lambda tmp: torch.onnx.export(
             module,
             module.get_dummy_inputs(),
             tmp,
@@ -45,20 +54,11 @@ def export_onnx(actor, path: Path) -> Path:
             dynamic_axes=_dynamic_axes(module),
             opset_version=ONNX_OPSET,
             dynamo=False,
-        )
-    os.replace(tmp, path)
-    return path
+        ),
+    )
 
 
 def export_jit(actor, path: Path) -> Path:
     """TorchScript of the actor (an LSTM keeps its state inside; `reset()` clears it)."""
     module = actor.as_jit().to("cpu").eval()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
-    os.close(fd)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # torch.jit.script's deprecation notice
-        torch.jit.save(torch.jit.script(module), tmp)
-    os.replace(tmp, path)
-    return path
+    return _write_atomically(path, lambda tmp: torch.jit.save(torch.jit.script(module), tmp))
