@@ -29,7 +29,8 @@ PAGE = Template(
 works; their numbers are not results.</p>{% endif %}
 <p>{{ n_runs }} run(s), {{ n_complete }} with evaluation results.</p>
 <h2 id="simulation">Simulation results</h2>
-<p>Mean ± standard error over units (all seeds pooled); best per column and difficulty in bold.
+<p>Mean ± standard deviation across units (all seeds pooled); best per column and difficulty in
+bold.
 Downloads: <a href="sim_table.tex">LaTeX</a>, <a href="sim_table.csv">CSV</a>.</p>
 {{ sim_table }}
 <h2 id="claim">Two-stage vs one-stage (paired)</h2>
