@@ -1,0 +1,43 @@
+"""The time-to-walk benchmark: it probes the policy in-process, stops where it is told, leaves
+a complete run, and calls a policy walking only under the paper's unclipped objective."""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from lca.bench import walk
+
+SMOKE = ["scale=smoke", "logger=none", "torch_threads=1", "sim.num_threads=1"]
+
+
+def test_until_stops_a_probed_run_that_is_complete(tmp_path):
+    out = walk.run(
+        [
+            *SMOKE,
+            f"run={tmp_path / 'run'}",
+            f"figure={tmp_path / 'walk.png'}",
+            "iterations=6",
+            "until=3",
+            "eval_every_s=0",
+            "eval.units=2",
+            "eval.steps=20",
+        ],
+        log=None,
+    )
+    run = tmp_path / "run"
+    curve = pd.read_csv(run / "train_curve.csv")
+    assert list(curve["iteration"]) == [0, 1, 2]  # stopped after `until` iterations of 6
+    probes = pd.read_csv(run / "probe_evals.csv")
+    assert list(probes["iteration"]) == [0, 1, 2]  # every iteration probed (eval_every_s=0)
+    assert set(probes["paper_objective"]) == {1}  # smoke: no curriculum, no clipping
+    assert (run / "COMPLETE").is_file() and (tmp_path / "walk.png").stat().st_size > 0
+    assert (run / "exported" / "policy.onnx").is_file()
+    assert out["env_steps"] == int(curve["env_steps"].iloc[-1])
+
+
+def test_walking_needs_the_paper_objective():
+    row = {"success": 100.0, "track_cm_s": 10.0, "penalty_scale": 1.0}
+    assert walk.walks({**row, "paper_objective": 1})
+    assert not walk.walks({**row, "paper_objective": 0})  # clipped or penalties scaled
+    assert not walk.walks({**row, "paper_objective": 1, "track_cm_s": 25.0})
+    assert not walk.walks({**row, "paper_objective": 1, "success": 80.0})
