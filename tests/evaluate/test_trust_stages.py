@@ -106,7 +106,8 @@ def test_compose_entry_points_take_group_overrides(tmp_path, module):
     _run_module([a.replace("{tmp}", str(tmp_path)) for a in module], REPO, timeout=120)
 
 
-def _run_module(args: list[str], cwd, timeout: int) -> None:
+def _run_module(args: list[str], cwd, timeout: int = 120, ok: bool = True):
+    """`python -m <args>` in `cwd`; asserts it succeeded (or, with ok=False, failed)."""
     done = subprocess.run(
         [sys.executable, "-m", *args],
         cwd=cwd,
@@ -116,7 +117,8 @@ def _run_module(args: list[str], cwd, timeout: int) -> None:
         timeout=timeout,
         check=False,
     )
-    assert done.returncode == 0, done.stderr[-2000:]
+    assert (done.returncode == 0) == ok, done.stderr[-2000:]
+    return done
 
 
 def test_stage_entry_points_take_group_overrides(tmp_path):
@@ -151,16 +153,7 @@ def test_a_locked_run_directory_is_refused_by_evaluation(tmp_path):
     holder = subprocess.Popen([sys.executable, "-c", hold, str(run.path)], stdout=subprocess.PIPE)
     try:
         assert holder.stdout.readline().strip() == b"locked"
-        done = subprocess.run(
-            [sys.executable, "-m", "lca.evaluate", f"run_dir={run.path}"],
-            cwd=tmp_path,
-            env=cli_env(),
-            capture_output=True,
-            text=True,
-            timeout=120,
-            check=False,
-        )
-        assert done.returncode != 0
+        done = _run_module(["lca.evaluate", f"run_dir={run.path}"], tmp_path, ok=False)
         assert f"in use by PID {holder.pid}" in done.stderr
     finally:
         holder.kill()
@@ -172,15 +165,6 @@ def test_unreadable_final_checkpoint_names_the_file_and_the_way_out(tmp_path):
     _, run = train_tiny_run(tmp_path / "run")
     final = next((run.path / "checkpoints").glob("final_*.pt"))
     final.write_bytes(final.read_bytes()[:1000])
-    done = subprocess.run(
-        [sys.executable, "-m", "lca.evaluate", f"run_dir={run.path}"],
-        cwd=tmp_path,
-        env=cli_env(),
-        capture_output=True,
-        text=True,
-        timeout=120,
-        check=False,
-    )
-    assert done.returncode != 0
+    done = _run_module(["lca.evaluate", f"run_dir={run.path}"], tmp_path, ok=False)
     assert f"cannot read checkpoint {final}" in done.stderr
     assert "force=true" in done.stderr
