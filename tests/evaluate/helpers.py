@@ -63,12 +63,10 @@ def evaluate_command(run_dir: Path, *overrides: str) -> list[str]:
     return [sys.executable, "-m", "lca.evaluate", f"run_dir={run_dir}", *overrides]
 
 
-def run_evaluate_cli(
-    run_dir: Path, *overrides: str, cwd: Path, timeout: float = 120
-) -> subprocess.CompletedProcess:
-    """`python -m lca.evaluate run_dir=<dir> [overrides]` from `cwd`."""
+def run_module(*args: str, cwd: Path, timeout: float = 120) -> subprocess.CompletedProcess:
+    """`python -m ARGS` from `cwd`, output captured."""
     return subprocess.run(
-        evaluate_command(run_dir, *overrides),
+        [sys.executable, "-m", *args],
         cwd=cwd,
         env=cli_env(),
         capture_output=True,
@@ -76,6 +74,13 @@ def run_evaluate_cli(
         timeout=timeout,
         check=False,
     )
+
+
+def run_evaluate_cli(
+    run_dir: Path, *overrides: str, cwd: Path, timeout: float = 120
+) -> subprocess.CompletedProcess:
+    """`python -m lca.evaluate run_dir=<dir> [overrides]` from `cwd`."""
+    return run_module(*evaluate_command(run_dir, *overrides)[2:], cwd=cwd, timeout=timeout)
 
 
 def sort_episodes(frame: pd.DataFrame) -> pd.DataFrame:

@@ -19,7 +19,7 @@ from lca.learn.rundir import RunDir
 from lca.pipeline import run_pipeline
 from lca.report.build import build_report
 
-from .helpers import REPO, SMOKE, cli_env, train_tiny_run
+from .helpers import REPO, SMOKE, run_evaluate_cli, run_module, train_tiny_run
 
 
 @pytest.fixture(scope="module")
@@ -103,22 +103,8 @@ def test_run_config_override_errors_name_the_key(tmp_path):
     ],
 )
 def test_compose_entry_points_take_group_overrides(tmp_path, module):
-    _run_module([a.replace("{tmp}", str(tmp_path)) for a in module], REPO, timeout=120)
-
-
-def _run_module(args: list[str], cwd, timeout: int = 120, ok: bool = True):
-    """`python -m <args>` in `cwd`; asserts it succeeded (or, with ok=False, failed)."""
-    done = subprocess.run(
-        [sys.executable, "-m", *args],
-        cwd=cwd,
-        env=cli_env(),
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-        check=False,
-    )
-    assert (done.returncode == 0) == ok, done.stderr[-2000:]
-    return done
+    done = run_module(*[a.replace("{tmp}", str(tmp_path)) for a in module], cwd=REPO)
+    assert done.returncode == 0, done.stderr[-2000:]
 
 
 def test_stage_entry_points_take_group_overrides(tmp_path):
@@ -141,7 +127,8 @@ def test_stage_entry_points_take_group_overrides(tmp_path):
             "hardware.tasks=[stair_ascent]",
         ],
     ):
-        _run_module(command, tmp_path, timeout=300)
+        done = run_module(*command, cwd=tmp_path, timeout=300)
+        assert done.returncode == 0, done.stderr[-2000:]
 
 
 def test_a_locked_run_directory_is_refused_by_evaluation(tmp_path):
@@ -153,7 +140,8 @@ def test_a_locked_run_directory_is_refused_by_evaluation(tmp_path):
     holder = subprocess.Popen([sys.executable, "-c", hold, str(run.path)], stdout=subprocess.PIPE)
     try:
         assert holder.stdout.readline().strip() == b"locked"
-        done = _run_module(["lca.evaluate", f"run_dir={run.path}"], tmp_path, ok=False)
+        done = run_evaluate_cli(run.path, cwd=tmp_path)
+        assert done.returncode != 0
         assert f"in use by PID {holder.pid}" in done.stderr
     finally:
         holder.kill()
@@ -165,6 +153,7 @@ def test_unreadable_final_checkpoint_names_the_file_and_the_way_out(tmp_path):
     _, run = train_tiny_run(tmp_path / "run")
     final = next((run.path / "checkpoints").glob("final_*.pt"))
     final.write_bytes(final.read_bytes()[:1000])
-    done = _run_module(["lca.evaluate", f"run_dir={run.path}"], tmp_path, ok=False)
+    done = run_evaluate_cli(run.path, cwd=tmp_path)
+    assert done.returncode != 0
     assert f"cannot read checkpoint {final}" in done.stderr
     assert "force=true" in done.stderr

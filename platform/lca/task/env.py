@@ -145,8 +145,9 @@ class LocomotionEnv(VecEnv):
         clip = self.task_cfg.action_clip
         self.last_action = self.action
         raw = actions.detach().cpu().numpy().astype(np.float64)
-        bad_action = ~np.isfinite(raw).all(axis=1)  # NaN / inf from the policy: counted, zeroed
-        self.action = np.clip(np.where(np.isfinite(raw), raw, 0.0), -clip, clip)
+        finite = np.isfinite(raw)
+        bad_action = ~finite.all(axis=1)  # NaN / inf from the policy: counted, zeroed
+        self.action = np.clip(np.where(finite, raw, 0.0), -clip, clip)
         self.sim.ctrl[:] = self.default_joint_pos + self.action_scale * self.action
         bad_before = ~np.isfinite(self.sim.qpos).all(1) | ~np.isfinite(self.sim.qvel).all(1)
         warnings_before = self._bad_state_warnings()
