@@ -20,8 +20,9 @@ from omegaconf import OmegaConf
 
 from lca.cli import split_option
 from lca.config import compose
+from lca.paths import root
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = root()
 BENCH_DIR = REPO / "reports" / "bench"
 
 

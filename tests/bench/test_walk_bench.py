@@ -4,10 +4,9 @@ a complete run, and calls a policy walking only under the paper's unclipped obje
 from __future__ import annotations
 
 import pandas as pd
+from _cli import SMOKE
 
 from lca.bench import walk
-
-SMOKE = ["scale=smoke", "logger=none", "torch_threads=1", "sim.num_threads=1"]
 
 
 def test_until_stops_a_probed_run_that_is_complete(tmp_path):

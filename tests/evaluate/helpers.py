@@ -8,12 +8,12 @@ iterations) on one torch and one mjbatch thread, and evaluated with tiny sizes
 
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 from pathlib import Path
 
 import pandas as pd
+from _cli import CONF, REPO, SMOKE, cli_env, run_module  # noqa: F401 (re-exported)
 from omegaconf import DictConfig
 
 from lca.config import compose
@@ -21,10 +21,6 @@ from lca.evaluate.protocol import cell_name
 from lca.learn.rundir import RunDir
 from lca.learn.trainer import Trainer
 
-REPO = Path(__file__).resolve().parents[2]
-CONF = REPO / "conf"
-# The smoke scale, quiet and on one thread (torch and mjbatch).
-SMOKE = ["scale=smoke", "logger=none", "torch_threads=1", "sim.num_threads=1"]
 UNITS, EPISODES, STEPS = 4, 2, 20
 EVAL = [f"eval.units={UNITS}", f"eval.episodes={EPISODES}", f"eval.steps={STEPS}"]
 POLICY_DT = 0.02  # s: 200 Hz physics, decimation 4
@@ -53,27 +49,8 @@ def episode_files(run_dir: Path, cfg: DictConfig) -> list[Path]:
     ]
 
 
-def cli_env() -> dict[str, str]:
-    env = {k: v for k, v in os.environ.items() if not k.startswith(("WANDB_", "HYDRA_"))}
-    env["PYTHONUNBUFFERED"] = "1"
-    return env
-
-
 def evaluate_command(run_dir: Path, *overrides: str) -> list[str]:
     return [sys.executable, "-m", "lca.evaluate", f"run_dir={run_dir}", *overrides]
-
-
-def run_module(*args: str, cwd: Path, timeout: float = 120) -> subprocess.CompletedProcess:
-    """`python -m ARGS` from `cwd`, output captured."""
-    return subprocess.run(
-        [sys.executable, "-m", *args],
-        cwd=cwd,
-        env=cli_env(),
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-        check=False,
-    )
 
 
 def run_evaluate_cli(

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from _cli import REPO
 
 from lca.config import compose
 from lca.evaluate.hardware import task_config
@@ -17,7 +18,6 @@ from lca.hardware.__main__ import main as hardware_main
 from lca.report.__main__ import main as report_main
 from lca.report.hardware_table import HARDWARE_ROWS, hardware_rows, hardware_table
 
-REPO = Path(__file__).resolve().parents[2]
 TASKS = ["stair_ascent", "soft_ledge"]
 
 

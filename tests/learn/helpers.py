@@ -9,11 +9,10 @@ subprocess, with their run store under pytest's tmp_path.
 from __future__ import annotations
 
 import csv
-import os
-import subprocess
 import sys
 from pathlib import Path
 
+from _cli import REPO, RUN_PY, SMOKE, cli_env, run_cli  # noqa: F401 (re-exported)
 from omegaconf import DictConfig
 
 from lca.config import compose
@@ -22,10 +21,6 @@ from lca.learn.trainer import Trainer
 from lca.sim.scene import Scene
 from lca.task.env import LocomotionEnv
 
-REPO = Path(__file__).resolve().parents[2]
-RUN_PY = REPO / "run.py"
-# The smoke scale, quiet and on one thread (torch and mjbatch).
-SMOKE = ["scale=smoke", "logger=none", "torch_threads=1", "sim.num_threads=1"]
 WANDB_KEYS = ("WANDB_DIR", "WANDB_RUN_GROUP", "WANDB_MODE")
 SWEEP_ARGS = ("-m", "actor=mlp,lstm", "scale=smoke", "logger=none", "torch_threads=1")
 
@@ -43,27 +38,8 @@ def read_curve(path: Path) -> list[dict]:
         return list(csv.DictReader(f))
 
 
-def cli_env() -> dict[str, str]:
-    env = {k: v for k, v in os.environ.items() if not k.startswith(("WANDB_", "HYDRA_"))}
-    env["PYTHONUNBUFFERED"] = "1"
-    return env
-
-
 def cli_command(*args: str) -> list[str]:
     return [sys.executable, str(RUN_PY), *args]
-
-
-def run_cli(*args: str, cwd: Path, timeout: float = 120) -> subprocess.CompletedProcess:
-    """`python run.py ARGS` from `cwd` (MuJoCo may drop a MUJOCO_LOG.TXT there)."""
-    return subprocess.run(
-        cli_command(*args),
-        cwd=cwd,
-        env=cli_env(),
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-        check=False,
-    )
 
 
 def complete_runs(runs_root: Path) -> list[Path]:

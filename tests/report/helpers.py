@@ -14,18 +14,16 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from _cli import REPO, cli_env, run_python  # noqa: F401 (re-exported)
 from omegaconf import OmegaConf
 
 from lca.config import compose
 
 HERE = Path(__file__).resolve().parent
-REPO = HERE.parents[1]
 FIXTURES = HERE / "fixtures"
 GOLDEN = HERE / "golden"
 UPDATE_GOLDEN = os.environ.get("LCA_UPDATE_GOLDEN") == "1"
@@ -143,22 +141,3 @@ def check_golden(produced: Path, name: str) -> None:
         shutil.copyfile(produced, golden)
     assert golden.is_file(), f"missing {golden}; generate it with LCA_UPDATE_GOLDEN=1"
     assert produced.read_text() == golden.read_text(), f"{produced} differs from {golden}"
-
-
-def cli_env() -> dict[str, str]:
-    env = {k: v for k, v in os.environ.items() if not k.startswith(("WANDB_", "HYDRA_"))}
-    env["PYTHONUNBUFFERED"] = "1"
-    return env
-
-
-def run_python(*args: str, cwd: Path, timeout: float = 120) -> subprocess.CompletedProcess:
-    """`python ARGS` from `cwd`, output captured."""
-    return subprocess.run(
-        [sys.executable, *args],
-        cwd=cwd,
-        env=cli_env(),
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-        check=False,
-    )

@@ -19,7 +19,6 @@ from lca.report.__main__ import main as report_main
 from lca.report.build import build_report
 from lca.report.collect import find_run_dirs, load_run
 from lca.report.figures import SMOOTH, reward_curves
-from lca.report.tables import DIFFICULTIES, TERRAINS
 
 from .helpers import NOT_A_RUN, cell_units, check_golden, fixture_cells, fixture_spec, train_curve
 
@@ -30,6 +29,8 @@ LABELS = {
     "one_lstm": "One-Stage LSTM",
 }
 ROWS = ["Blind", "One-Stage MLP", "Two-Stage MLP"]  # the evaluated policies, paper order
+TERRAINS = {"stairs": "Stairs", "uneven": "Uneven Terrain"}  # the fixture store's terrains
+DIFFICULTIES = ("medium", "hard")
 BOLD = r"\textbf{"
 
 

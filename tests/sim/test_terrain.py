@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from lca.config import compose
-from lca.config.schema import TERRAIN_TYPES
+from lca.config.registry import TILES
 from lca.sim.terrain import Terrain, Tile, generate, tile_kinds
 
 # Paper table "Environment parameters" (m).
@@ -163,9 +163,9 @@ def test_mixture_gives_each_kind_equally() -> None:
     assert (cfg.terrain.rows, cfg.terrain.cols) == (4, 4)
     for seed in range(5):
         counts = Counter(tile_kinds(cfg.terrain, np.random.default_rng(seed)))
-        assert counts == dict.fromkeys(TERRAIN_TYPES, 4), counts
+        assert counts == dict.fromkeys(TILES.names(), 4), counts
     terrain = generate(cfg.terrain, cfg.difficulty)
-    assert Counter(t.kind for t in terrain.tiles) == dict.fromkeys(TERRAIN_TYPES, 4)
+    assert Counter(t.kind for t in terrain.tiles) == dict.fromkeys(TILES.names(), 4)
     # Each tile's heights match its kind.
     lo, hi = cfg.difficulty.uneven_height
     for tile in terrain.tiles:

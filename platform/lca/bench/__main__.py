@@ -6,7 +6,8 @@ import argparse
 import importlib
 import json
 import sys
-from pathlib import Path
+
+from lca.paths import reports_dir
 
 BENCHMARKS = ("sim", "env", "train", "learn", "walk", "levers")
 
@@ -19,7 +20,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_intermixed_args(argv)
     module = importlib.import_module(f"lca.bench.{args.name}")
     result = module.run(args.overrides, log=None if args.json else print)
-    save_dir = Path(__file__).resolve().parents[3] / "reports" / "bench"
+    save_dir = reports_dir() / "bench"
     save_dir.mkdir(parents=True, exist_ok=True)
     (save_dir / f"{args.name}.json").write_text(json.dumps(result, indent=2))
     if args.json:

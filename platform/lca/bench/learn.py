@@ -19,9 +19,10 @@ import pandas as pd  # noqa: E402
 from lca.config import compose  # noqa: E402
 from lca.learn.run import train_run  # noqa: E402
 from lca.learn.rundir import RunDir  # noqa: E402
+from lca.paths import reports_dir
 
 BASE = ["terrain=flat", "curriculum=blind", "actor=mlp", "encoder=mlp", "logger=none"]
-REPORTS = Path(__file__).resolve().parents[3] / "reports"
+REPORTS = reports_dir()
 
 
 def _window(curve: pd.DataFrame, column: str, first: bool, frac: float = 0.1) -> float:

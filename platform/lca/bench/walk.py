@@ -31,12 +31,13 @@ from lca.config.schema import EvalCell  # noqa: E402
 from lca.evaluate.probe import TrainingProbe  # noqa: E402
 from lca.learn.rundir import RunDir  # noqa: E402
 from lca.learn.trainer import Trainer  # noqa: E402
+from lca.paths import reports_dir
 
 BASE = ["terrain=flat", "curriculum=blind", "actor=mlp", "encoder=mlp", "logger=none"]
 # the probe's protocol, recorded in the run's config.yaml so `python -m lca.evaluate` on the
 # run (flat cell) repeats the last probe exactly: same cell config, seeds and sizes
 PROTOCOL = ["eval.units=64", "eval.episodes=1", "eval.steps=1000"]
-REPORTS = Path(__file__).resolve().parents[3] / "reports"
+REPORTS = reports_dir()
 FLAT_CELL = EvalCell("flat", "medium")
 SUCCESS_MIN = 90.0  # %
 TRACK_MAX = 20.0  # cm/s

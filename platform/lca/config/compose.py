@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
-
 from hydra import compose as hydra_compose
 from hydra import initialize_config_dir
 from omegaconf import DictConfig, OmegaConf
@@ -12,16 +9,9 @@ from omegaconf.errors import ConfigKeyError, ValidationError
 
 from lca.config import schema
 from lca.config.schema import ConfigValueError
+from lca.paths import conf_dir
 
 ConfigError = ConfigValueError
-
-
-def conf_dir() -> Path:
-    """The `conf/` folder: $LCA_CONF_DIR, else the one beside `platform/` in this checkout."""
-    env = os.environ.get("LCA_CONF_DIR")
-    if env:
-        return Path(env).resolve()
-    return Path(__file__).resolve().parents[3] / "conf"
 
 
 def _reject_unknown_keys(cfg: DictConfig) -> None:

@@ -11,11 +11,8 @@ from dataclasses import dataclass, field
 from hydra.core.config_store import ConfigStore
 from omegaconf import MISSING
 
-TERRAIN_TYPES = ("flat", "stairs_up", "stairs_down", "uneven")
-
-
-class ConfigValueError(ValueError):
-    """A config value outside its allowed range; the message starts with the full key."""
+from lca.config.errors import ConfigValueError
+from lca.config.registry import ACTORS, ENCODERS, EVAL_TERRAINS, REWARD_TERMS, TILES
 
 
 def _require(ok: bool, key: str, message: str) -> None:
@@ -103,17 +100,9 @@ class RobotConfig:
 
 
 @dataclass
-class TerrainMixture:
-    flat: float = 0.0
-    stairs_up: float = 0.0
-    stairs_down: float = 0.0
-    uneven: float = 0.0
-
-
-@dataclass
 class TerrainConfig:
     name: str = "mixed"
-    mixture: TerrainMixture = field(default_factory=TerrainMixture)
+    mixture: dict[str, float] = field(default_factory=dict)  # tile name -> weight (sum 1)
     rows: int = 4
     cols: int = 4
     tile_size: float = 8.0  # m, square tiles
@@ -129,9 +118,11 @@ class TerrainConfig:
     seed: int = 0
 
     def check(self) -> None:
-        weights = [getattr(self.mixture, t) for t in TERRAIN_TYPES]
-        _require(min(weights) >= 0, "terrain.mixture", f"weights must be >= 0, got {weights}")
-        named = dict(zip(TERRAIN_TYPES, weights, strict=True))
+        for name in self.mixture:
+            TILES.check(name, f"terrain.mixture.{name}")
+        named = dict(self.mixture)
+        weights = list(named.values()) or [0.0]
+        _require(min(weights) >= 0, "terrain.mixture", f"weights must be >= 0, got {named}")
         _require(
             abs(sum(weights) - 1.0) < 1e-6,
             "terrain.mixture",
@@ -273,14 +264,8 @@ class RewardCurriculumConfig:
         )
         allowed = ("episode_length", "iterations", "tracking")
         _require(self.by in allowed, f"{key}.by", f"unknown '{self.by}'; allowed: {allowed}")
-        from lca.task.rewards import REWARD_TERMS  # task layer owns the names
-
         for name in self.terms:
-            _require(
-                name in REWARD_TERMS,
-                f"{key}.terms",
-                f"unknown reward term '{name}'; allowed: {sorted(REWARD_TERMS)}",
-            )
+            REWARD_TERMS.check(name, f"{key}.terms")
 
 
 @dataclass
@@ -336,14 +321,8 @@ class TaskConfig:
         _require(
             0 <= self.commands.standing_fraction <= 1, "task.commands.standing_fraction", "[0, 1]"
         )
-        from lca.task.rewards import REWARD_TERMS  # task layer owns the names
-
         for name in self.rewards:
-            _require(
-                name in REWARD_TERMS,
-                f"task.rewards.{name}",
-                f"unknown reward term; allowed: {sorted(REWARD_TERMS)}",
-            )
+            REWARD_TERMS.check(name, f"task.rewards.{name}")
 
 
 @dataclass
@@ -438,14 +417,10 @@ class HardwareConfig:
         _require(self.trials >= 1, "hardware.trials", "must be >= 1")
 
 
-ACTOR_KINDS = ("mlp", "lstm")
-ENCODER_KINDS = ("cnn", "mlp")
-
-
 @dataclass
 class ActorConfig:
     name: str = "mlp"
-    kind: str = "mlp"  # mlp | lstm
+    kind: str = "mlp"  # a registered actor kind (lca.learn.variants): mlp | lstm
     hidden_dims: list[int] = field(default_factory=lambda: [512, 256, 128])
     activation: str = "elu"
     rnn_hidden_dim: int = 256  # LSTM width before the MLP head (lstm only)
@@ -464,9 +439,7 @@ class ActorConfig:
     noise_by: str = "iterations"
 
     def check(self) -> None:
-        _require(
-            self.kind in ACTOR_KINDS, "actor.kind", f"unknown '{self.kind}'; allowed: {ACTOR_KINDS}"
-        )
+        ACTORS.check(self.kind, "actor.kind")
         _require(self.init_noise_std > 0, "actor.init_noise_std", "must be > 0")
         _require(
             0 <= self.final_noise_std <= self.init_noise_std,
@@ -486,7 +459,7 @@ class ActorConfig:
 @dataclass
 class EncoderConfig:
     name: str = "cnn"
-    kind: str = "cnn"  # cnn | mlp
+    kind: str = "cnn"  # a registered encoder kind (lca.learn.variants): cnn | mlp
     hidden_dims: list[int] = field(default_factory=lambda: [256, 256])
     latent_dim: int = 32  # z_H
     conv_channels: list[int] = field(default_factory=lambda: [8, 16])  # cnn only
@@ -495,11 +468,7 @@ class EncoderConfig:
     pool: int = 0  # max-pool after each convolution (cnn only); 0: none (the paper's CNN)
 
     def check(self) -> None:
-        _require(
-            self.kind in ENCODER_KINDS,
-            "encoder.kind",
-            f"unknown '{self.kind}'; allowed: {ENCODER_KINDS}",
-        )
+        ENCODERS.check(self.kind, "encoder.kind")
         _require(
             self.pool in (0, 2, 3), "encoder.pool", f"allowed: 0 (none), 2, 3; got {self.pool}"
         )
@@ -561,7 +530,6 @@ class AlgoConfig:
         )
 
 
-EVAL_TERRAINS = ("stairs", "uneven", "flat", "stairs_up", "stairs_down", "mixed")
 DIFFICULTIES = ("medium", "hard")
 
 
@@ -591,10 +559,14 @@ class EvalConfig:
         for key in ("units", "episodes", "steps"):
             _require(getattr(self, key) >= 1, f"eval.{key}", "must be >= 1")
         for i, cell in enumerate(self.cells):
+            allowed = [
+                *EVAL_TERRAINS.names(),
+                *(t for t in TILES.names() if t not in EVAL_TERRAINS),
+            ]
             _require(
-                cell.terrain in EVAL_TERRAINS,
+                cell.terrain in allowed,
                 f"eval.cells[{i}].terrain",
-                f"unknown '{cell.terrain}'; allowed: {EVAL_TERRAINS}",
+                f"unknown evaluation terrain '{cell.terrain}'; allowed: {allowed}",
             )
             _require(
                 cell.difficulty in DIFFICULTIES,

@@ -20,21 +20,13 @@ import pandas as pd
 import torch
 from omegaconf import DictConfig, OmegaConf
 
-from lca.config import load_option, schema
+from lca.config import load_option
 from lca.evaluate.metrics import episode_metrics
 from lca.evaluate.policy import final_checkpoint, load_policy
+from lca.evaluate.terrains import eval_mixture
 from lca.learn import curriculum
 from lca.learn.rundir import atomic_write
 from lca.task.env import LocomotionEnv
-
-CELL_MIXTURES = {
-    "stairs": {"stairs_up": 0.5, "stairs_down": 0.5},
-    "uneven": {"uneven": 1.0},
-    "flat": {"flat": 1.0},
-    "stairs_up": {"stairs_up": 1.0},
-    "stairs_down": {"stairs_down": 1.0},
-    "mixed": {"flat": 0.25, "stairs_up": 0.25, "stairs_down": 0.25, "uneven": 0.25},
-}
 
 
 def cell_name(cell) -> str:
@@ -72,9 +64,7 @@ def cell_config(cfg: DictConfig, cell) -> DictConfig:
     ev = cfg.eval
     episode_s = ev.steps * cfg.sim.timestep * cfg.sim.decimation
     c = trial_config(cfg, ev.units, episode_s, ev.command_x)
-    mixture = {t: 0.0 for t in schema.TERRAIN_TYPES} | CELL_MIXTURES[cell.terrain]
-    for kind, weight in mixture.items():
-        setattr(c.terrain.mixture, kind, weight)
+    c.terrain.mixture = eval_mixture(cell.terrain)
     c.terrain.name = cell.terrain
     c.difficulty = difficulty_config(cell.difficulty)
     return c

@@ -10,9 +10,10 @@ import mujoco
 
 from lca.cli import split_option
 from lca.config import compose
+from lca.paths import assets_dir
 from lca.sim.hardware import TASKS, build_task
 
-DEFAULT_OUT = Path(__file__).resolve().parents[3] / "assets" / "hardware"
+DEFAULT_OUT = assets_dir() / "hardware"
 
 
 def main(argv: list[str] | None = None) -> int:

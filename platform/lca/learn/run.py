@@ -14,6 +14,7 @@ from omegaconf import DictConfig
 from lca.config.runtime import set_torch_threads
 from lca.learn.rundir import RunDir
 from lca.learn.trainer import Trainer
+from lca.learn.variants import actor_spec
 
 
 def job_threads(cfg: DictConfig) -> int:
@@ -53,6 +54,8 @@ def train_run(cfg: DictConfig, run: RunDir) -> dict:
     os.environ["WANDB_DIR"] = str(run.path)
     for noisy in ("onnxscript", "onnx_ir", "torch.onnx"):
         logging.getLogger(noisy).setLevel(logging.WARNING)
+    if not actor_spec(cfg.actor.kind).exports:
+        print(f"[lca] actor kind '{cfg.actor.kind}' declares no export: exported/ is skipped")
     t0 = time.perf_counter()
     trainer = Trainer(cfg, run)
     last = trainer.train()

@@ -21,6 +21,8 @@ from pathlib import Path
 
 from omegaconf import DictConfig, OmegaConf
 
+from lca.paths import root
+
 LOCK = ".lock"
 _HELD: dict[Path, int] = {}  # run directories this process has locked -> nesting depth
 PACKAGES = ("lca", "torch", "mujoco", "mjbatch", "rsl-rl-lib", "hydra-core", "numpy", "tensordict")
@@ -168,7 +170,7 @@ class RunDir:
                 entry.unlink()
 
     def write_provenance(self, cfg: DictConfig, overrides: list[str], choices: dict) -> None:
-        repo = Path(__file__).resolve().parents[3]
+        repo = root()
         atomic_write(self.path / "config.yaml", OmegaConf.to_yaml(cfg, resolve=True))
         provenance = {
             "overrides": list(overrides),

@@ -7,10 +7,8 @@ import os
 
 from omegaconf import DictConfig, OmegaConf
 
-ACTOR_CLASSES = {
-    "mlp": "lca.learn.models:PerceptiveMLPModel",
-    "lstm": "lca.learn.models:PerceptiveRNNModel",
-}
+from lca.learn.variants import actor_spec
+
 CRITIC_CLASS = "lca.learn.models:PerceptiveMLPModel"
 SYMMETRY_FUNC = "lca.learn.symmetry:augment"
 OBS_GROUPS = {"actor": ["policy", "height"], "critic": ["critic", "critic_height"]}
@@ -37,7 +35,8 @@ def build_train_cfg(cfg: DictConfig, run_name: str) -> dict:
     symmetry_cfg = None
     mirror_loss = algo.pop("mirror_loss_coeff")
     # rsl-rl's symmetry extension takes feed-forward actors only; recurrent ones train without
-    recurrent = cfg.actor.kind == "lstm"
+    spec = actor_spec(cfg.actor.kind)
+    recurrent = spec.recurrent
     if (algo.pop("symmetry") or mirror_loss > 0) and not recurrent:
         symmetry_cfg = {
             "use_data_augmentation": bool(cfg.algo.symmetry),
@@ -46,7 +45,7 @@ def build_train_cfg(cfg: DictConfig, run_name: str) -> dict:
             "data_augmentation_func": SYMMETRY_FUNC,
         }
     actor = {
-        "class_name": ACTOR_CLASSES[cfg.actor.kind],
+        "class_name": spec.class_path,
         "hidden_dims": list(cfg.actor.hidden_dims),
         "activation": cfg.actor.activation,
         "obs_normalization": obs_normalization,
@@ -57,8 +56,9 @@ def build_train_cfg(cfg: DictConfig, run_name: str) -> dict:
             "std_type": "scalar",
         },
     }
-    if cfg.actor.kind == "lstm":
-        actor |= {"rnn_type": "lstm", "rnn_hidden_dim": cfg.actor.rnn_hidden_dim}
+    actor |= spec.model_kwargs
+    if recurrent:
+        actor["rnn_hidden_dim"] = cfg.actor.rnn_hidden_dim
     critic = {
         "class_name": CRITIC_CLASS,
         "hidden_dims": list(cfg.actor.hidden_dims),  # paper: the critic has the actor's sizes

@@ -31,6 +31,7 @@ from lca.learn.export import export_jit, export_onnx
 from lca.learn.reward_curriculum import RewardCurriculum
 from lca.learn.rundir import RunDir
 from lca.learn.train_cfg import build_train_cfg
+from lca.learn.variants import actor_spec
 from lca.task.env import LocomotionEnv
 from lca.task.env_state import env_state, restore_env_state
 
@@ -387,6 +388,9 @@ class Trainer:
         return it
 
     def export(self) -> dict[str, Path]:
+        """ONNX + TorchScript of the final actor; nothing for a kind that declares no export."""
+        if not actor_spec(self.cfg.actor.kind).exports:
+            return {}
         actor = self.alg.get_policy()
         return {
             "onnx": export_onnx(actor, self.run.exported / "policy.onnx"),

@@ -9,6 +9,8 @@ from pathlib import Path
 import pandas as pd
 from omegaconf import OmegaConf
 
+from lca.config.registry import ACTORS, ENCODERS
+
 ROW_ORDER = [
     "Blind",
     "One-Stage MLP",
@@ -25,17 +27,21 @@ POOLED = " (pooled)"  # a CNN with max-pooling is not the paper's CNN
 
 
 def policy_label(curriculum: str, actor: str, encoder: str, pool: int = 0) -> str:
-    """The paper's row name, from the run's composed config (never from folder names).
+    """The paper's row name, from the run's composed config (never from folder names) and the
+    registered labels of its actor and encoder kinds (lca.learn.variants).
 
     MLP = MLP actor + MLP encoder, CNN = MLP actor + CNN encoder, LSTM = LSTM actor
-    (+ MLP encoder; with a CNN encoder it is reported as LSTM-CNN). A CNN encoder with
-    max-pooling (`encoder.pool`) reads "CNN (pooled)"."""
+    (+ MLP encoder; with a CNN encoder it is reported as LSTM-CNN), and likewise for any
+    registered actor kind. A CNN encoder with max-pooling (`encoder.pool`) reads
+    "CNN (pooled)". A kind nobody registered fails loudly, naming the allowed ones."""
     if curriculum == "blind":
         return "Blind"
-    if actor == "lstm":
-        arch = "LSTM" if encoder == "mlp" else "LSTM-CNN"
+    actor_label = ACTORS.label(actor)
+    encoder_label = ENCODERS.label(encoder)
+    if actor == "mlp":
+        arch = encoder_label
     else:
-        arch = "CNN" if encoder == "cnn" else "MLP"
+        arch = actor_label if encoder == "mlp" else f"{actor_label}-{encoder_label}"
     pooled = POOLED if encoder == "cnn" and pool > 1 else ""
     return f"{STAGES.get(curriculum, curriculum)} {arch}{pooled}"
 

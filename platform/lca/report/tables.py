@@ -12,10 +12,10 @@ from lca.evaluate.metrics import (
     summarize,
     unit_values,
 )
+from lca.evaluate.terrains import eval_label, eval_terrains
 from lca.report.collect import RunRecord, row_key
 
-TERRAINS = {"stairs": "Stairs", "uneven": "Uneven Terrain"}
-DIFFICULTIES = {"medium": "Medium difficulty", "hard": "Hard difficulty"}
+DIFFICULTY_ORDER = ["medium", "hard"]  # the paper's blocks; other difficulties follow, sorted
 LOWER_IS_BETTER = {"contacts_per_step", "track_cm_s"}
 RESAMPLES, CONFIDENCE, SEED = 2000, 0.95, 0
 CLAIM_COLUMNS = [
@@ -65,21 +65,39 @@ def _cell_text(mean: float, sd: float, metric: str) -> str:
     return f"{mean:.2f}" if metric == "success" else f"{mean:.2f} $\\pm$ {sd:.2f}"
 
 
+def difficulty_label(name: str) -> str:
+    return f"{name.capitalize()} difficulty"
+
+
+def table_terrains(table: pd.DataFrame) -> list[str]:
+    """The evaluation terrains of `table`, in column order; one nobody registered fails
+    loudly rather than being dropped from the table."""
+    present = set(table["terrain"])
+    known = eval_terrains()
+    unknown = sorted(present - set(known))
+    if unknown:
+        raise ValueError(
+            f"results name unregistered evaluation terrain(s) {unknown}; known: {known}"
+        )
+    return [t for t in known if t in present]
+
+
 def wide_table(table: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
     """(display strings, numeric means), indexed (difficulty block, policy), columns
     (terrain, metric label), in the paper's layout."""
-    diffs = [d for d in DIFFICULTIES if d in set(table["difficulty"])]
-    terrains = [t for t in TERRAINS if t in set(table["terrain"])]
+    present = set(table["difficulty"])
+    diffs = [d for d in DIFFICULTY_ORDER if d in present]
+    diffs += sorted(present - set(DIFFICULTY_ORDER))
+    terrains = table_terrains(table)
     policies = sorted(table["policy"].unique(), key=row_key)
-    index = pd.MultiIndex.from_product([[DIFFICULTIES[d] for d in diffs], policies])
-    columns = pd.MultiIndex.from_product([[TERRAINS[t] for t in terrains], list(METRICS.values())])
+    index = pd.MultiIndex.from_product([[difficulty_label(d) for d in diffs], policies])
+    labels = [eval_label(t) for t in terrains]
+    columns = pd.MultiIndex.from_product([labels, list(METRICS.values())])
     text = pd.DataFrame("--", index=index, columns=columns)
     means = pd.DataFrame(np.nan, index=index, columns=columns)
     for row in table.itertuples():
-        if row.terrain not in TERRAINS or row.difficulty not in DIFFICULTIES:
-            continue
-        key = (DIFFICULTIES[row.difficulty], row.policy)
-        col = (TERRAINS[row.terrain], METRICS[row.metric])
+        key = (difficulty_label(row.difficulty), row.policy)
+        col = (eval_label(row.terrain), METRICS[row.metric])
         text.loc[key, col] = _cell_text(row.mean, row.sd, row.metric)
         means.loc[key, col] = row.mean
     return text, means

@@ -10,17 +10,17 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
 
 import mujoco
 import numpy as np
 from omegaconf import DictConfig
 
 from lca.config.schema import HardwareConfig
+from lca.paths import assets_dir
 from lca.sim.scene import Scene, build_scene
 from lca.sim.terrain import Terrain, Tile
 
-ASSETS = Path(__file__).resolve().parents[3] / "assets" / "hardware"
+ASSETS = assets_dir() / "hardware"
 EXTENT_X = (-1.5, 6.0)  # m, heightfield extent around the task
 EXTENT_Y = (-2.0, 2.0)
 

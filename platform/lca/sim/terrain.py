@@ -15,7 +15,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from lca.config.schema import TERRAIN_TYPES, DifficultyConfig, TerrainConfig
+from lca.config.registry import TILES
+from lca.config.schema import DifficultyConfig, TerrainConfig
 
 
 @dataclass
@@ -77,14 +78,16 @@ class Terrain:
 
 
 def tile_kinds(cfg: TerrainConfig, rng: np.random.Generator) -> list[str]:
-    """Tile types in proportion to the mixture weights (largest remainder), shuffled."""
+    """Tile types in proportion to the mixture weights (largest remainder, ties in
+    registration order), shuffled."""
     n = cfg.rows * cfg.cols
-    weights = np.array([getattr(cfg.mixture, t) for t in TERRAIN_TYPES], float)
+    names = TILES.names()
+    weights = np.array([float(cfg.mixture.get(t, 0.0)) for t in names], float)
     exact = weights / weights.sum() * n
     counts = np.floor(exact).astype(int)
     for i in np.argsort(-(exact - counts), kind="stable")[: n - counts.sum()]:
         counts[i] += 1
-    kinds = [t for t, k in zip(TERRAIN_TYPES, counts, strict=True) for _ in range(k)]
+    kinds = [t for t, k in zip(names, counts, strict=True) for _ in range(k)]
     return [kinds[i] for i in rng.permutation(n)]
 
 
@@ -112,6 +115,38 @@ def _blocks(lx, ly, cfg, low, high, rng) -> np.ndarray:
     return np.where(on_platform, (low + high) / 2, h)
 
 
+# Tile generators: (lx, ly) are sample offsets (m) from the tile centre; each returns the
+# heights there and the parameters it drew. They run in tile order on one RNG stream.
+TileOut = tuple[np.ndarray, dict[str, float]]
+
+
+@TILES.register("flat", label="Flat")
+def flat_tile(lx, ly, cfg: TerrainConfig, difficulty: DifficultyConfig, rng) -> TileOut:
+    return np.zeros_like(lx), {}
+
+
+def _stairs_tile(lx, ly, cfg, difficulty, rng, up: bool) -> TileOut:
+    riser = float(rng.uniform(*difficulty.stairs_riser))
+    params = {"riser": riser, "tread": difficulty.stairs_tread}
+    return _stairs(lx, ly, cfg, riser, difficulty.stairs_tread, up=up), params
+
+
+@TILES.register("stairs_up", label="Stairs up")
+def stairs_up_tile(lx, ly, cfg: TerrainConfig, difficulty: DifficultyConfig, rng) -> TileOut:
+    return _stairs_tile(lx, ly, cfg, difficulty, rng, up=True)
+
+
+@TILES.register("stairs_down", label="Stairs down")
+def stairs_down_tile(lx, ly, cfg: TerrainConfig, difficulty: DifficultyConfig, rng) -> TileOut:
+    return _stairs_tile(lx, ly, cfg, difficulty, rng, up=False)
+
+
+@TILES.register("uneven", label="Uneven Terrain")
+def uneven_tile(lx, ly, cfg: TerrainConfig, difficulty: DifficultyConfig, rng) -> TileOut:
+    low, high = difficulty.uneven_height
+    return _blocks(lx, ly, cfg, low, high, rng), {"low": low, "high": high}
+
+
 def generate(cfg: TerrainConfig, difficulty: DifficultyConfig, seed: int | None = None) -> Terrain:
     """Build the whole tile grid. Deterministic in (config, difficulty, seed)."""
     rng = np.random.default_rng(cfg.seed if seed is None else seed)
@@ -128,17 +163,7 @@ def generate(cfg: TerrainConfig, difficulty: DifficultyConfig, seed: int | None 
     for index, kind in enumerate(tile_kinds(cfg, rng)):
         row, col = divmod(index, cfg.cols)
         centre = ((col + 0.5) * cfg.tile_size, (row + 0.5) * cfg.tile_size)
-        params: dict[str, float] = {}
-        if kind in ("stairs_up", "stairs_down"):
-            riser = float(rng.uniform(*difficulty.stairs_riser))
-            params = {"riser": riser, "tread": difficulty.stairs_tread}
-            h = _stairs(lx, ly, cfg, riser, difficulty.stairs_tread, up=kind == "stairs_up")
-        elif kind == "uneven":
-            low, high = difficulty.uneven_height
-            params = {"low": low, "high": high}
-            h = _blocks(lx, ly, cfg, low, high, rng)
-        else:
-            h = np.zeros_like(lx)
+        h, params = TILES[kind](lx, ly, cfg, difficulty, rng)
         r0, c0 = border_n + row * tile_n, border_n + col * tile_n
         heights[r0 : r0 + tile_n, c0 : c0 + tile_n] = h
         tiles.append(Tile(kind, row, col, centre, params))

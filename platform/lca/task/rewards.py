@@ -7,11 +7,11 @@ Rewards section: contact C_i = 1(|F_i| > F*), stance intent s_i = 1(phi_i < tau 
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
+from lca.config.registry import REWARD_TERMS
 from lca.config.schema import RewardParams
 from lca.task.state import RobotState
 
@@ -164,35 +164,35 @@ def termination_penalty(c: RewardContext) -> np.ndarray:
     return c.terminated.astype(float)
 
 
-REWARD_TERMS: dict[str, Callable[[RewardContext], np.ndarray]] = {
-    f.__name__: f
-    for f in (
-        track_lin_vel_xy_exp,
-        track_ang_vel_z_exp,
-        lin_vel_z_l2,
-        ang_vel_xy_l2,
-        dof_torques_l2,
-        dof_acc_l2,
-        dof_vel_l2,
-        action_rate_l2,
-        undesired_contacts,
-        contact_no_vel,
-        joint_deviation_hip,
-        joint_deviation_arms,
-        joint_deviation_torso,
-        height_torso,
-        feet_clearance,
-        feet_slide,
-        phase_contact,
-        stand_still,
-        feet_flat,
-        flat_orientation_l2,
-        dof_pos_limits,
-        alive,
-        termination_penalty,
-        feet_strike,
-    )
-}
+# The table's terms, registered by name (lca.config.registry); a plugin adds its own the
+# same way, REWARD_TERMS.register("name")(f), then gives it a weight under task.rewards.
+for _term in (
+    track_lin_vel_xy_exp,
+    track_ang_vel_z_exp,
+    lin_vel_z_l2,
+    ang_vel_xy_l2,
+    dof_torques_l2,
+    dof_acc_l2,
+    dof_vel_l2,
+    action_rate_l2,
+    undesired_contacts,
+    contact_no_vel,
+    joint_deviation_hip,
+    joint_deviation_arms,
+    joint_deviation_torso,
+    height_torso,
+    feet_clearance,
+    feet_slide,
+    phase_contact,
+    stand_still,
+    feet_flat,
+    flat_orientation_l2,
+    dof_pos_limits,
+    alive,
+    termination_penalty,
+    feet_strike,
+):
+    REWARD_TERMS.register(_term.__name__)(_term)
 
 
 def compute_rewards(

@@ -1,0 +1,7 @@
+"""The built-in variants: importing these modules registers every tile, reward term, actor
+and encoder kind and evaluation terrain the package ships (see lca.config.registry)."""
+
+import lca.evaluate.terrains  # noqa: F401
+import lca.learn.variants  # noqa: F401
+import lca.sim.terrain  # noqa: F401
+import lca.task.rewards  # noqa: F401

@@ -1,0 +1,43 @@
+"""Three variants added from outside the lca package, each one registration (plus one YAML
+under conf/): a GRU actor, a `slopes` terrain tile and a reward term."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from lca.config.registry import ACTORS, REWARD_TERMS, TILES
+from lca.learn.variants import ActorSpec
+
+GRU = ActorSpec(
+    "lca.learn.models:PerceptiveRNNModel",
+    recurrent=True,
+    exports=False,  # the platform's exporter handles LSTM state only: say so up front
+    model_kwargs={"rnn_type": "gru"},
+)
+SLOPE_GRADE = 0.15  # rise per metre of a slopes tile, outwards from its spawn platform
+
+
+def slopes_tile(lx, ly, cfg, difficulty, rng):
+    """A square cone: flat on the spawn platform, rising SLOPE_GRADE per metre outwards."""
+    ring = np.maximum(np.abs(lx), np.abs(ly)) - cfg.platform / 2
+    return SLOPE_GRADE * np.clip(ring, 0.0, None), {"grade": SLOPE_GRADE}
+
+
+def base_yaw_rate_l2(c) -> np.ndarray:
+    """Squared yaw rate of the base (rad/s)^2: a turning penalty."""
+    return c.state.base_ang_vel[:, 2] ** 2
+
+
+def register() -> None:
+    ACTORS.register("gru", label="GRU")(GRU)
+    TILES.register("slopes", label="Slopes")(slopes_tile)
+    REWARD_TERMS.register("base_yaw_rate_l2")(base_yaw_rate_l2)
+
+
+def unregister() -> None:
+    ACTORS.unregister("gru")
+    TILES.unregister("slopes")
+    REWARD_TERMS.unregister("base_yaw_rate_l2")
+
+
+register()  # importing the module (LCA_PLUGINS or an entry point) registers the variants
