@@ -14,8 +14,8 @@ from omegaconf import DictConfig
 
 from lca.evaluate.run import evaluate_and_write
 from lca.learn.run import train_run
-from lca.learn.rundir import FAILED, RunDir
 from lca.report.build import build_report
+from lca.store import FAILED, RunDir
 
 
 def run_pipeline(

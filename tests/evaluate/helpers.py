@@ -18,7 +18,7 @@ from omegaconf import DictConfig
 
 from lca.config import compose
 from lca.evaluate.protocol import cell_name
-from lca.learn.rundir import RunDir
+from lca.store import RunDir
 from lca.learn.trainer import Trainer
 
 UNITS, EPISODES, STEPS = 4, 2, 20

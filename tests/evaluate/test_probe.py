@@ -10,7 +10,7 @@ import torch
 
 from lca.config.schema import EvalCell
 from lca.evaluate.probe import PROBE_FIELDS, TrainingProbe
-from lca.learn.rundir import RunDir
+from lca.store import RunDir
 from lca.learn.trainer import Trainer
 from lca.sim.scene import Scene, build_scene
 from lca.task.env import LocomotionEnv

@@ -15,7 +15,7 @@ from omegaconf import OmegaConf
 
 from lca.config import compose
 from lca.evaluate.policy import load_run_config
-from lca.learn.rundir import RunDir
+from lca.store import RunDir
 from lca.pipeline import run_pipeline
 from lca.report.build import build_report
 
@@ -134,7 +134,7 @@ def test_stage_entry_points_take_group_overrides(tmp_path):
 def test_a_locked_run_directory_is_refused_by_evaluation(tmp_path):
     _, run = train_tiny_run(tmp_path / "run")
     hold = (
-        "import sys, time; from lca.learn.rundir import RunDir\n"
+        "import sys, time; from lca.store import RunDir\n"
         "with RunDir(sys.argv[1]).lock():\n    print('locked', flush=True); time.sleep(60)\n"
     )
     holder = subprocess.Popen([sys.executable, "-c", hold, str(run.path)], stdout=subprocess.PIPE)

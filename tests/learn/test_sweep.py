@@ -17,7 +17,7 @@ import torch
 from omegaconf import OmegaConf
 
 from lca.config import compose
-from lca.learn.rundir import PACKAGES
+from lca.store import PACKAGES
 
 from .helpers import (
     REPO,

@@ -14,7 +14,7 @@ import pytest
 import torch
 
 from lca.learn.run import train_run
-from lca.learn.rundir import RunDir
+from lca.store import RunDir
 
 from .helpers import WANDB_KEYS, make_trainer, read_curve, smoke_cfg
 

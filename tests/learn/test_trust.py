@@ -13,13 +13,13 @@ import numpy as np
 import pytest
 import torch
 
-from lca.learn.rundir import RunDir, RunLockedError
+from lca.store import RunDir, RunLockedError
 from lca.learn.trainer import CURVE_FIELDS
 
 from .helpers import make_trainer, read_curve, smoke_cfg
 
 HOLD = (
-    "import sys, time; from lca.learn.rundir import RunDir\n"
+    "import sys, time; from lca.store import RunDir\n"
     "with RunDir(sys.argv[1]).lock():\n"
     "    print('locked', flush=True); time.sleep(60)\n"
 )

@@ -18,8 +18,8 @@ import pandas as pd  # noqa: E402
 
 from lca.config import compose  # noqa: E402
 from lca.learn.run import train_run  # noqa: E402
-from lca.learn.rundir import RunDir  # noqa: E402
 from lca.paths import reports_dir
+from lca.store import RunDir  # noqa: E402
 
 BASE = ["terrain=flat", "curriculum=blind", "actor=mlp", "encoder=mlp", "logger=none"]
 REPORTS = reports_dir()

@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from lca.config import compose, set_torch_threads
-from lca.learn.rundir import RunDir
 from lca.learn.trainer import Trainer
+from lca.store import RunDir
 
 WARMUP = 1
 ITERATIONS = 6

@@ -29,9 +29,9 @@ from lca.config import compose  # noqa: E402
 from lca.config.runtime import set_torch_threads  # noqa: E402
 from lca.config.schema import EvalCell  # noqa: E402
 from lca.evaluate.probe import TrainingProbe  # noqa: E402
-from lca.learn.rundir import RunDir  # noqa: E402
 from lca.learn.trainer import Trainer  # noqa: E402
 from lca.paths import reports_dir
+from lca.store import RunDir  # noqa: E402
 
 BASE = ["terrain=flat", "curriculum=blind", "actor=mlp", "encoder=mlp", "logger=none"]
 # the probe's protocol, recorded in the run's config.yaml so `python -m lca.evaluate` on the

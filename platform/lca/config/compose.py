@@ -74,6 +74,17 @@ def _delta(before, after):
 _SAME = object()
 
 
+def _removed(before, after, path: tuple = ()) -> list[tuple]:
+    """Paths of the keys of `before` that `after` no longer has (e.g. a mixture's tiles)."""
+    if not (isinstance(before, dict) and isinstance(after, dict)):
+        return []
+    out = [(*path, k) for k in before if k not in after]
+    for k in before:
+        if k in after:
+            out += _removed(before[k], after[k], (*path, k))
+    return out
+
+
 def override_config(
     base: DictConfig, overrides: list[str], base_overrides: list[str] | None = None
 ) -> DictConfig:
@@ -90,8 +101,13 @@ def override_config(
         before, common = OmegaConf.to_container(compose([]), resolve=True), []
     after = OmegaConf.to_container(compose([*common, *overrides]), resolve=True)
     change = _delta(before, after)
-    if change is _SAME:
+    gone = _removed(before, after)
+    if change is _SAME and not gone:
         return base
-    merged = OmegaConf.merge(base, change)
+    merged = OmegaConf.merge(base, {} if change is _SAME else change)
+    for *parent, key in gone:
+        node = OmegaConf.select(merged, ".".join(parent)) if parent else merged
+        if node is not None and key in node:
+            del node[key]
     validate(merged)
     return merged

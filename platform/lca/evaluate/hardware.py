@@ -19,9 +19,10 @@ from omegaconf import DictConfig
 from lca.config import load_option
 from lca.evaluate.policy import final_checkpoint, load_policy
 from lca.evaluate.protocol import trial_config
+from lca.evaluate.rollout import rollout, start
 from lca.learn import curriculum
-from lca.learn.rundir import RunDir, atomic_write
 from lca.sim.hardware import HardwareTask, build_task
+from lca.store import RunDir, atomic_write
 from lca.task.env import LocomotionEnv
 
 
@@ -37,23 +38,19 @@ def task_config(cfg: DictConfig) -> DictConfig:
 @torch.inference_mode()
 def run_trials(env: LocomotionEnv, policy, task: HardwareTask, steps: int) -> pd.DataFrame:
     n = env.num_envs
-    obs = env.reset_all()
-    policy.reset(torch.ones(n, dtype=torch.bool, device=env.device))
+    obs = start(env, policy)
     start_y = env.sim.qpos[:, 1].copy()
     active = np.ones(n, dtype=bool)
     success = np.zeros(n, dtype=bool)
     drift = np.full(n, np.nan)
     time_s = np.full(n, np.nan)
-    for step in range(steps):
-        obs, _, dones, extras = env.step(policy(obs))
-        m = extras["metrics"]
+    for step, m in rollout(env, policy, obs, steps):
         done_now = active & (m["base_pos"][:, 0] >= task.goal_x) & ~m["terminated"]
         success |= done_now
         # the net lateral drift, signed: the table's precision removes a fixed bias
         drift = np.where(done_now, m["base_pos"][:, 1] - start_y, drift)
         time_s = np.where(done_now, (step + 1) * env.dt, time_s)
         active &= ~(done_now | m["terminated"] | m["time_out"])
-        policy.reset(dones.bool())
         if not active.any():
             break
     return pd.DataFrame(

@@ -23,9 +23,10 @@ from omegaconf import DictConfig, OmegaConf
 from lca.config import load_option
 from lca.evaluate.metrics import episode_metrics
 from lca.evaluate.policy import final_checkpoint, load_policy
+from lca.evaluate.rollout import rollout, start
 from lca.evaluate.terrains import eval_mixture
 from lca.learn import curriculum
-from lca.learn.rundir import atomic_write
+from lca.store import atomic_write
 from lca.task.env import LocomotionEnv
 
 
@@ -74,23 +75,19 @@ def cell_config(cfg: DictConfig, cell) -> DictConfig:
 def run_round(env: LocomotionEnv, policy, steps: int) -> dict[str, np.ndarray]:
     """One episode for every unit; a unit stops counting at its first termination."""
     n = env.num_envs
-    obs = env.reset_all()
-    policy.reset(torch.ones(n, dtype=torch.bool, device=env.device))
+    obs = start(env, policy)
     alive = np.ones(n, dtype=bool)
     success = np.zeros(n, dtype=bool)
     alive_steps = np.zeros(n)
     impacts = np.zeros(n)
     track = np.zeros(n)
     command_x = env.commands.value[:, 0].copy()
-    for _ in range(steps):
-        obs, _, dones, extras = env.step(policy(obs))
-        m = extras["metrics"]
+    for _, m in rollout(env, policy, obs, steps):
         alive_steps += alive
         impacts += alive & m["lateral_impact"]
         track += np.where(alive, m["track_error"], 0.0)
         success |= alive & m["time_out"]
         alive &= ~(m["terminated"] | m["time_out"])
-        policy.reset(dones.bool())
         if not alive.any():
             break
     out = episode_metrics(alive_steps, impacts, track, success)

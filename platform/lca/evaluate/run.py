@@ -11,7 +11,7 @@ import pandas as pd
 from lca.evaluate.metrics import summarize
 from lca.evaluate.policy import load_run_config
 from lca.evaluate.protocol import evaluate_run
-from lca.learn.rundir import RunDir, atomic_write
+from lca.store import RunDir, atomic_write
 
 
 def evaluate_and_write(

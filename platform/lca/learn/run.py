@@ -12,9 +12,9 @@ from pathlib import Path
 from omegaconf import DictConfig
 
 from lca.config.runtime import set_torch_threads
-from lca.learn.rundir import RunDir
 from lca.learn.trainer import Trainer
 from lca.learn.variants import actor_spec
+from lca.store import RunDir
 
 
 def job_threads(cfg: DictConfig) -> int:

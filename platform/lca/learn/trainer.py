@@ -29,9 +29,9 @@ from lca.learn.episode_stats import EpisodeStats
 from lca.learn.exploration import apply_ceiling, noise_ceiling, set_initial_stds
 from lca.learn.export import export_jit, export_onnx
 from lca.learn.reward_curriculum import RewardCurriculum
-from lca.learn.rundir import RunDir
 from lca.learn.train_cfg import build_train_cfg
 from lca.learn.variants import actor_spec
+from lca.store import RunDir
 from lca.task.env import LocomotionEnv
 from lca.task.env_state import env_state, restore_env_state
 

@@ -21,9 +21,17 @@ from lca.sim.batch import BatchedSim
 from lca.sim.depth_camera import CameraSpec, DepthCameras
 from lca.sim.scene import Scene, build_scene
 from lca.task import heightmap, observations, perception
+from lca.task.actions import action_scales, joint_ids
 from lca.task.commands import VelocityCommand, gait_phase
 from lca.task.rewards import RewardContext, compute_rewards
-from lca.task.state import ContactAccumulator, RobotState, read_state, yaw_of
+from lca.task.state import (
+    ContactAccumulator,
+    RobotState,
+    read_state,
+    replace_rows,
+    yaw_of,
+    zero_rows,
+)
 from lca.task.terminations import fell, non_finite
 
 BAD_STATE_WARNINGS = [
@@ -47,20 +55,6 @@ class EnvConfig:
 
     def to_dict(self) -> dict:
         return OmegaConf.to_container(self._cfg, resolve=True)
-
-
-def joint_ids(names: list[str], *patterns: str) -> np.ndarray:
-    return np.array([i for i, n in enumerate(names) if any(p in n for p in patterns)], dtype=int)
-
-
-def action_scales(model: mujoco.MjModel, task) -> np.ndarray:
-    """(J,) rad per unit action: one scale, or scale * effort limit / kp per joint."""
-    n = model.nu
-    if not task.action_scale_by_effort:
-        return np.full(n, float(task.action_scale))
-    kp = model.actuator_gainprm[:, 0]
-    effort = model.actuator_forcerange[:, 1]
-    return float(task.action_scale) * effort / kp
 
 
 class LocomotionEnv(VecEnv):
@@ -162,7 +156,7 @@ class LocomotionEnv(VecEnv):
         state = read_state(self.sim, self.contacts)
         broken = bad_before | bad_action | (self._bad_state_warnings() > warnings_before)
         broken |= non_finite(state, self.task_cfg.terminations.max_joint_vel)
-        state = _sanitise(state, broken)
+        state = zero_rows(state, broken)
         fallen = fell(state, self.task_cfg.terminations) & ~broken
         terminated = fallen | broken
         time_out = (self._episode_steps >= self.max_episode_length) & ~terminated
@@ -195,7 +189,7 @@ class LocomotionEnv(VecEnv):
         extras["log"]["Curriculum/command_floor"] = self.commands.min_speed
         self._reset_envs(done_ids)
         if done_ids.size:
-            state = _replace_rows(state, read_state(self.sim, self.contacts, done_ids), done_ids)
+            state = replace_rows(state, read_state(self.sim, self.contacts, done_ids), done_ids)
         self._obs = self._observe(state, reset_ids=done_ids)
         self.episode_length_buf = torch.as_tensor(self._episode_steps, device=self.device)
         return (
@@ -395,18 +389,3 @@ class LocomotionEnv(VecEnv):
         )
         drop = self.task_cfg.observations.height_dropout
         return heightmap.actor_map(raw, self.height_noise, drop, self.rng)
-
-
-def _sanitise(state: RobotState, broken: np.ndarray) -> RobotState:
-    """Zero the rows of broken envs: `non_finite` flags every row holding a NaN or inf."""
-    if broken.any():
-        for value in vars(state).values():
-            value[broken] = 0.0
-    return state
-
-
-def _replace_rows(state: RobotState, fresh: RobotState, ids: np.ndarray) -> RobotState:
-    """Put `fresh` (the state of rows `ids` only) into `state`."""
-    for name, value in vars(state).items():
-        value[ids] = getattr(fresh, name)
-    return state

@@ -128,3 +128,18 @@ def read_state(
         foot_lateral_force=np.array(contacts.foot_lateral[rows]),
         leg_contact_force=np.array(contacts.leg_force[rows]),
     )
+
+
+def zero_rows(state: RobotState, broken: np.ndarray) -> RobotState:
+    """Zero the rows of broken envs: `non_finite` flags every row holding a NaN or inf."""
+    if broken.any():
+        for value in vars(state).values():
+            value[broken] = 0.0
+    return state
+
+
+def replace_rows(state: RobotState, fresh: RobotState, ids: np.ndarray) -> RobotState:
+    """Put `fresh` (the state of rows `ids` only) into `state`."""
+    for name, value in vars(state).items():
+        value[ids] = getattr(fresh, name)
+    return state

@@ -1,0 +1,55 @@
+"""Config group of the evaluation protocol: units, episodes, steps and cells."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from omegaconf import MISSING
+
+from lca.config.errors import check_range, require
+from lca.config.registry import EVAL_TERRAINS, TILES
+
+DIFFICULTIES = ("medium", "hard")
+
+
+@dataclass
+class EvalCell:
+    terrain: str = MISSING  # stairs (= half up, half down) | uneven | flat | stairs_up | ...
+    difficulty: str = MISSING  # medium | hard
+
+
+@dataclass
+class EvalConfig:
+    name: str = "default"
+    units: int = 32  # simulated robots per cell (paper: 500)
+    episodes: int = 2  # episodes per unit (paper: 3)
+    steps: int = 500  # policy steps per episode (paper: 1000)
+    cells: list[EvalCell] = field(
+        default_factory=lambda: [
+            EvalCell(t, d) for t in ("stairs", "uneven") for d in ("medium", "hard")
+        ]
+    )
+    command_x: list[float] = field(default_factory=lambda: [0.3, 0.6])  # m/s forward
+    seed: int = 12345
+    bootstrap_resamples: int = 2000
+    confidence: float = 0.95
+
+    def check(self) -> None:
+        for key in ("units", "episodes", "steps"):
+            require(getattr(self, key) >= 1, f"eval.{key}", "must be >= 1")
+        for i, cell in enumerate(self.cells):
+            allowed = [
+                *EVAL_TERRAINS.names(),
+                *(t for t in TILES.names() if t not in EVAL_TERRAINS),
+            ]
+            require(
+                cell.terrain in allowed,
+                f"eval.cells[{i}].terrain",
+                f"unknown evaluation terrain '{cell.terrain}'; allowed: {allowed}",
+            )
+            require(
+                cell.difficulty in DIFFICULTIES,
+                f"eval.cells[{i}].difficulty",
+                f"unknown '{cell.difficulty}'; allowed: {DIFFICULTIES}",
+            )
+        check_range("eval.command_x", self.command_x, -1e9)

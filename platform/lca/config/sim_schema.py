@@ -1,0 +1,142 @@
+"""Config groups of the simulation stage: physics, robot, terrain, difficulty."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from omegaconf import MISSING
+
+from lca.config.errors import check_range, require
+from lca.config.registry import TILES
+
+
+@dataclass
+class SimConfig:
+    timestep: float = 0.005  # 200 Hz physics
+    decimation: int = 4  # 50 Hz policy
+    integrator: str = "implicitfast"
+    cone: str = "pyramidal"
+    iterations: int = 10  # bounded solver work per step
+    ls_iterations: int = 5
+    bvactive: bool = False  # MuJoCo's default (on) makes stepping ~3x slower
+    num_threads: int = 0  # mjbatch worker threads; 0 = every logical CPU
+
+    def check(self) -> None:
+        require(self.timestep > 0, "sim.timestep", f"must be > 0, got {self.timestep}")
+        require(self.decimation >= 1, "sim.decimation", f"must be >= 1, got {self.decimation}")
+        allowed = ("euler", "implicit", "implicitfast", "rk4")
+        require(self.integrator in allowed, "sim.integrator", f"allowed: {allowed}")
+        require(self.cone in ("pyramidal", "elliptic"), "sim.cone", "allowed: pyramidal, elliptic")
+        require(self.iterations >= 1, "sim.iterations", f"must be >= 1, got {self.iterations}")
+
+
+@dataclass
+class ActuatorGroup:
+    joints: list[str] = MISSING  # regexes over joint names
+    rotor_inertia: list[float] = MISSING  # kg m^2 of each planetary stage, motor side first
+    gear_ratio: list[float] = MISSING  # ratio of each stage (first is 1)
+    motors: int = 1  # motors driving the joint through a linkage (ankles, waist roll/pitch: 2)
+    effort_limit: float = MISSING  # N m
+
+
+@dataclass
+class RobotConfig:
+    name: str = "g1"
+    # PD gains from armature: kp = I w^2, kd = 2 zeta I w (w = 2 pi f); stiff yet stable at 200 Hz
+    natural_frequency_hz: float = 10.0
+    damping_ratio: float = 2.0
+    # Explicit gains (joint name regex -> N m/rad, N m s/rad) override the armature rule for
+    # the joints they match, e.g. IsaacLab's G1 gains (conf/robot/g1_isaaclab.yaml).
+    stiffness: dict[str, float] = field(default_factory=dict)
+    damping: dict[str, float] = field(default_factory=dict)
+    actuators: dict[str, ActuatorGroup] = field(default_factory=dict)
+    home: dict[str, float] = field(default_factory=dict)  # joint name regex -> angle (rad)
+    home_base_height: float = 0.0  # 0: computed so the feet rest on the ground
+    collision_parts: list[str] = field(default_factory=lambda: ["feet", "legs", "torso", "arms"])
+    self_collision: bool = False
+    foot_friction: float = 1.0
+    # Sole contact spheres in the ankle-roll frame (toes, heels); the sole is at z = -0.035.
+    foot_spheres: list[list[float]] = field(
+        default_factory=lambda: [
+            [0.13, 0.026, -0.025],
+            [0.13, -0.026, -0.025],
+            [-0.05, 0.02, -0.025],
+            [-0.05, -0.02, -0.025],
+        ]
+    )
+    foot_sphere_radius: float = 0.01
+
+    def check(self) -> None:
+        for name, group in self.actuators.items():
+            key = f"robot.actuators.{name}"
+            require(len(group.rotor_inertia) == len(group.gear_ratio), key, "stage counts differ")
+            require(group.effort_limit > 0, f"{key}.effort_limit", "must be > 0")
+        allowed = ("feet", "legs", "torso", "arms")
+        for part in self.collision_parts:
+            require(
+                part in allowed, "robot.collision_parts", f"unknown '{part}'; allowed: {allowed}"
+            )
+        require(self.natural_frequency_hz > 0, "robot.natural_frequency_hz", "must be > 0")
+        require(self.damping_ratio > 0, "robot.damping_ratio", "must be > 0")
+        for key in ("stiffness", "damping"):
+            for pattern, value in getattr(self, key).items():
+                require(value >= 0, f"robot.{key}.{pattern}", f"must be >= 0, got {value}")
+
+
+@dataclass
+class TerrainConfig:
+    name: str = "mixed"
+    mixture: dict[str, float] = field(default_factory=dict)  # tile name -> weight (sum 1)
+    rows: int = 4
+    cols: int = 4
+    tile_size: float = 8.0  # m, square tiles
+    resolution: float = 0.01  # m per heightfield sample; 1 cm keeps 0.31/0.23 m treads exact
+    border: float = 1.0  # m of flat ground around the whole grid (part of the heightfield)
+    # m of flat ground (boxes at height 0) beyond the heightfield on every side: a unit
+    # walking 20 s in any heading never leaves the world
+    apron: float = 30.0
+    flat_as_plane: bool = True  # an all-flat grid is an infinite plane (cheaper contacts)
+    platform: float = 1.5  # m, flat square at each tile centre where the robot spawns
+    num_steps: int = 8  # steps per pyramid side (stairs_up / stairs_down)
+    block_size: float = 0.4  # m, side of a block of the uneven field
+    seed: int = 0
+
+    def check(self) -> None:
+        for name in self.mixture:
+            TILES.check(name, f"terrain.mixture.{name}")
+        named = dict(self.mixture)
+        weights = list(named.values()) or [0.0]
+        require(min(weights) >= 0, "terrain.mixture", f"weights must be >= 0, got {named}")
+        require(
+            abs(sum(weights) - 1.0) < 1e-6,
+            "terrain.mixture",
+            f"weights must sum to 1, got {sum(weights):.6g} ({named})",
+        )
+        require(self.rows >= 1 and self.cols >= 1, "terrain.rows/cols", "must be >= 1")
+        require(self.resolution > 0, "terrain.resolution", "must be > 0")
+        for key in ("tile_size", "border", "platform", "block_size"):
+            value = getattr(self, key)
+            require(
+                abs(value / self.resolution - round(value / self.resolution)) < 1e-6,
+                f"terrain.{key}",
+                f"{value} m is not a multiple of terrain.resolution={self.resolution}",
+            )
+        require(self.platform < self.tile_size, "terrain.platform", "must be < tile_size")
+        require(self.apron >= 0, "terrain.apron", f"must be >= 0, got {self.apron}")
+        require(self.num_steps >= 1, "terrain.num_steps", f"must be >= 1, got {self.num_steps}")
+
+
+@dataclass
+class DifficultyConfig:
+    name: str = "medium"
+    stairs_riser: list[float] = field(default_factory=lambda: [0.14, 0.18])  # m
+    stairs_tread: float = 0.31  # m
+    uneven_height: list[float] = field(default_factory=lambda: [0.05, 0.20])  # m
+    height_noise: float = 0.10  # m, uniform noise on the actor's heightmap (task layer)
+
+    def check(self) -> None:
+        check_range("difficulty.stairs_riser", self.stairs_riser)
+        require(self.stairs_riser[0] > 0, "difficulty.stairs_riser", "must be > 0")
+        require(self.stairs_tread > 0, "difficulty.stairs_tread", "must be > 0")
+        check_range("difficulty.uneven_height", self.uneven_height)
+        require(self.height_noise >= 0, "difficulty.height_noise", "must be >= 0")

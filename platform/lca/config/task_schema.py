@@ -1,0 +1,176 @@
+"""Config group of the task stage: the locomotion MDP (resets, randomisation, observations,
+commands, rewards and their curricula, terminations)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from lca.config.errors import check_range, require
+from lca.config.registry import REWARD_TERMS
+
+
+@dataclass
+class ResetConfig:
+    joint_pos_noise: float = 0.05  # rad, uniform
+    joint_vel_noise: float = 0.0
+    base_xy_noise: float = 0.1  # m, uniform around the tile centre
+    yaw_range: float = 3.14159  # rad, uniform spawn heading
+
+
+@dataclass
+class RandomizationConfig:
+    enabled: bool = True
+    friction: list[float] = field(default_factory=lambda: [0.6, 1.25])  # scale, per reset
+    added_base_mass: list[float] = field(default_factory=lambda: [-1.0, 3.0])  # kg, at start
+    push_interval_s: float = 8.0  # s between pushes; 0 disables
+    push_velocity: float = 0.5  # m/s, uniform planar base velocity kick
+
+
+@dataclass
+class ObservationConfig:
+    history: int = 5  # K proprioception frames, newest first
+    noise: bool = True  # actor observation noise on/off
+    height_dropout: float = 0.05  # fraction of actor heightmap cells dropped (set to the mean)
+    actor_grid: list[int] = field(default_factory=lambda: [11, 11])
+    actor_spacing: float = 0.1  # m: 11 x 11 cells over 1.0 m x 1.0 m
+    critic_grid: list[int] = field(default_factory=lambda: [16, 16])
+    critic_spacing: float = 0.1  # m: 16 x 16 cells over 1.5 m x 1.5 m
+
+
+@dataclass
+class CommandConfig:
+    lin_vel_x: list[float] = field(default_factory=lambda: [-0.6, 0.6])  # m/s
+    lin_vel_y: list[float] = field(default_factory=lambda: [-0.3, 0.3])  # m/s
+    ang_vel_z: list[float] = field(default_factory=lambda: [-0.5, 0.5])  # rad/s
+    standing_fraction: float = 0.1  # share of commands that are exactly zero
+    resample_time_s: float = 10.0
+    standing_epsilon: float = 5e-3  # ||u|| below this is a standing command (paper)
+
+
+@dataclass
+class RewardParams:
+    tracking_sigma: float = 0.25  # exp(-err^2 / 0.25) (paper)
+    gait_period: float = 0.8  # s (paper)
+    stance_fraction: float = 0.55  # tau (paper)
+    contact_threshold: float = 1.0  # N (paper F*)
+    strike_threshold: float = 100.0  # N of lateral foot force that counts as a strike (paper)
+    base_height_target: float = 0.77  # m above the ground (paper)
+    swing_height: float = 0.08  # m, nominal swing clearance of the sole
+    stand_height: float = 0.0  # m, target when standing: the sole site is on the sole
+    clearance_scale: float = 0.08  # m, h_scale normalising the clearance error
+    clearance_gate: float = 10.0  # kappa in tanh(kappa * |v_xy|)
+    flat_feet_k: float = 25.0  # k_theta (paper)
+    soft_limit_factor: float = 0.95  # joint range share inside which dof_pos_limits is zero
+
+
+@dataclass
+class TerminationConfig:
+    min_base_height: float = 0.35  # m above the ground
+    max_tilt: float = 1.0  # rad between base z-axis and world z
+    max_joint_vel: float = 1000.0  # rad/s; above this the state counts as non-finite
+
+
+@dataclass
+class RewardCurriculumConfig:
+    """Penalties (every negative reward contribution, the termination penalty included)
+    scaled from `penalty_start` up to the paper's weights as the mean episode length grows.
+    The scale never decreases and is exactly 1 from `deadline` x max_iterations on, so
+    training always ends on the paper's objective."""
+
+    enabled: bool = False
+    penalty_start: float = 0.1  # fraction of the paper's penalty weights at the start
+    # what raises the scale: the mean episode length (length_start -> length_end); the
+    # iteration (linearly from 0 to the deadline); or tracking: a step per iteration while
+    # episodes are long enough (length_start) and the robot follows its commands (gate)
+    by: str = "episode_length"
+    gate: float = 0.5  # tracking: 1 - |u - v| / |u| over moving commands needed to step up
+    ramp: float = 0.25  # tracking: fraction of max_iterations a full, never-gated ramp takes
+    length_start: float = 0.2  # ramp starts at this mean episode length (fraction of the max)
+    length_end: float = 0.8  # ... and reaches the paper's weights at this one
+    deadline: float = 0.75  # fraction of max_iterations from which the weights are the paper's
+    only_positive: bool = False  # legged_gym's clip of the step's sum at 0 while scale < 1
+    # the length- or tracking-driven scale stops at `hold` (1: no hold); from `hold_until` x
+    # max_iterations it rises linearly to 1 at the deadline, so a gait found under light
+    # penalties gets time to settle before the table's weights arrive
+    hold: float = 1.0
+    hold_until: float = 0.5
+    # terms scaled (their negative contributions); empty: every term, termination included
+    terms: list[str] = field(default_factory=list)
+
+    def check(self) -> None:
+        key = "task.reward_curriculum"
+        require(0 <= self.penalty_start <= 1, f"{key}.penalty_start", "must be in [0, 1]")
+        require(
+            0 <= self.length_start < self.length_end <= 1,
+            f"{key}.length_start/length_end",
+            f"need 0 <= start < end <= 1, got {self.length_start}, {self.length_end}",
+        )
+        require(0 <= self.deadline <= 1, f"{key}.deadline", "must be in [0, 1]")
+        require(0 < self.ramp <= 1, f"{key}.ramp", "must be in (0, 1]")
+        require(0 < self.hold <= 1, f"{key}.hold", "must be in (0, 1]")
+        require(
+            self.hold >= 1 or 0 <= self.hold_until < self.deadline,
+            f"{key}.hold_until",
+            f"need 0 <= hold_until < deadline, got {self.hold_until}, {self.deadline}",
+        )
+        allowed = ("episode_length", "iterations", "tracking")
+        require(self.by in allowed, f"{key}.by", f"unknown '{self.by}'; allowed: {allowed}")
+        for name in self.terms:
+            REWARD_TERMS.check(name, f"{key}.terms")
+
+
+@dataclass
+class CommandCurriculumConfig:
+    """Early commands walk: planar commands slower than a floor are scaled up to it (their
+    direction kept). The floor falls linearly from `min_speed` to 0 at `deadline` x
+    max_iterations, from where commands are the configured distribution."""
+
+    enabled: bool = False
+    min_speed: float = 0.3  # m/s, the floor at the first iteration
+    deadline: float = 0.6  # fraction of max_iterations where the floor reaches 0
+
+    def check(self) -> None:
+        key = "task.command_curriculum"
+        require(self.min_speed >= 0, f"{key}.min_speed", "must be >= 0")
+        require(0 <= self.deadline <= 1, f"{key}.deadline", "must be in [0, 1]")
+
+
+@dataclass
+class TaskConfig:
+    name: str = "locomotion"
+    num_envs: int = 256
+    episode_length_s: float = 20.0
+    action_scale: float = 0.25  # rad per unit action around the default pose
+    # True: joint j's scale is action_scale * effort_limit_j / kp_j (mjlab's G1 rule), so a
+    # unit action asks for the same fraction of each joint's torque
+    action_scale_by_effort: bool = False
+    action_clip: float = 10.0
+    perception: bool = True  # False: the actor's heightmap is exactly zero
+    reset: ResetConfig = field(default_factory=ResetConfig)
+    randomization: RandomizationConfig = field(default_factory=RandomizationConfig)
+    observations: ObservationConfig = field(default_factory=ObservationConfig)
+    commands: CommandConfig = field(default_factory=CommandConfig)
+    rewards: dict[str, float] = field(default_factory=dict)
+    only_positive_rewards: bool = False  # clip the step's sum (but termination) at 0, always
+    reward_curriculum: RewardCurriculumConfig = field(default_factory=RewardCurriculumConfig)
+    command_curriculum: CommandCurriculumConfig = field(default_factory=CommandCurriculumConfig)
+    reward_params: RewardParams = field(default_factory=RewardParams)
+    terminations: TerminationConfig = field(default_factory=TerminationConfig)
+
+    def check(self) -> None:
+        require(self.num_envs >= 1, "task.num_envs", f"must be >= 1, got {self.num_envs}")
+        self.reward_curriculum.check()
+        self.command_curriculum.check()
+        check_range("task.randomization.friction", self.randomization.friction)
+        check_range("task.randomization.added_base_mass", self.randomization.added_base_mass, -1e9)
+        require(self.observations.history >= 1, "task.observations.history", "must be >= 1")
+        require(
+            0 <= self.observations.height_dropout < 1, "task.observations.height_dropout", "[0, 1)"
+        )
+        for key in ("lin_vel_x", "lin_vel_y", "ang_vel_z"):
+            check_range(f"task.commands.{key}", getattr(self.commands, key), -1e9)
+        require(
+            0 <= self.commands.standing_fraction <= 1, "task.commands.standing_fraction", "[0, 1]"
+        )
+        for name in self.rewards:
+            REWARD_TERMS.check(name, f"task.rewards.{name}")

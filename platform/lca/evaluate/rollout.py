@@ -1,0 +1,28 @@
+"""The one rollout loop every test of a trained policy uses: evaluation rounds, hardware-style
+trials and the training probes. A recurrent policy's state restarts with each episode."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import torch
+from tensordict import TensorDict
+
+from lca.task.env import LocomotionEnv
+
+
+def start(env: LocomotionEnv, policy) -> TensorDict:
+    """Every unit reset (and the policy's memory with it); the first observations."""
+    obs = env.reset_all()
+    policy.reset(torch.ones(env.num_envs, dtype=torch.bool, device=env.device))
+    return obs
+
+
+def rollout(env: LocomotionEnv, policy, obs: TensorDict, steps: int) -> Iterator[tuple[int, dict]]:
+    """Up to `steps` policy steps from `obs`, yielding (step, the env's per-unit metrics);
+    the caller stops early by leaving the loop."""
+    for step in range(steps):
+        with torch.inference_mode():
+            obs, _, dones, extras = env.step(policy(obs))
+        yield step, extras["metrics"]
+        policy.reset(dones.bool())
