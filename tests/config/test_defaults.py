@@ -30,6 +30,11 @@ def disagreements(code, yaml, key: str) -> list[str]:
             if isinstance(code, dict) and k in code:
                 out += disagreements(code[k], v, f"{key}.{k}")
         return out
+    if isinstance(yaml, list) and isinstance(code, list) and len(yaml) == len(code):
+        out = []
+        for i, (c, y) in enumerate(zip(code, yaml, strict=True)):
+            out += disagreements(c, y, f"{key}[{i}]")
+        return out
     if code == "???":  # MISSING in the schema: the YAML is the one source
         return []
     same = code == yaml or (
@@ -55,5 +60,6 @@ def test_default_option_equals_the_schema_defaults(group: str, name: str) -> Non
 
 def test_a_drifted_default_is_caught() -> None:
     assert disagreements({"a": {"b": [8, 16]}}, {"a": {"b": [16, 16]}}, "x") == [
-        "x.a.b: code [8, 16] != yaml [16, 16]"
+        "x.a.b[0]: code 8 != yaml 16"
     ]
+    assert disagreements({"a": [1]}, {"a": [1, 2]}, "x") == ["x.a: code [1] != yaml [1, 2]"]

@@ -18,8 +18,8 @@ from omegaconf import DictConfig
 
 from lca.config import compose
 from lca.evaluate.protocol import cell_name
-from lca.store import RunDir
 from lca.learn.trainer import Trainer
+from lca.store import RunDir
 
 UNITS, EPISODES, STEPS = 4, 2, 20
 EVAL = [f"eval.units={UNITS}", f"eval.episodes={EPISODES}", f"eval.steps={STEPS}"]

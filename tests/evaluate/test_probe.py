@@ -10,9 +10,9 @@ import torch
 
 from lca.config.schema import EvalCell
 from lca.evaluate.probe import PROBE_FIELDS, TrainingProbe
-from lca.store import RunDir
 from lca.learn.trainer import Trainer
 from lca.sim.scene import Scene, build_scene
+from lca.store import RunDir
 from lca.task.env import LocomotionEnv
 
 from .helpers import smoke_cfg

@@ -15,9 +15,9 @@ from omegaconf import OmegaConf
 
 from lca.config import compose
 from lca.evaluate.policy import load_run_config
-from lca.store import RunDir
 from lca.pipeline import run_pipeline
 from lca.report.build import build_report
+from lca.store import RunDir
 
 from .helpers import REPO, SMOKE, run_evaluate_cli, run_module, train_tiny_run
 

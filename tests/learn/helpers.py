@@ -16,9 +16,9 @@ from _cli import REPO, RUN_PY, SMOKE, cli_env, run_cli  # noqa: F401 (re-exporte
 from omegaconf import DictConfig
 
 from lca.config import compose
-from lca.store import COMPLETE, RunDir
 from lca.learn.trainer import Trainer
 from lca.sim.scene import Scene
+from lca.store import COMPLETE, RunDir
 from lca.task.env import LocomotionEnv
 
 WANDB_KEYS = ("WANDB_DIR", "WANDB_RUN_GROUP", "WANDB_MODE")

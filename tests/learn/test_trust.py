@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 import torch
 
-from lca.store import RunDir, RunLockedError
 from lca.learn.trainer import CURVE_FIELDS
+from lca.store import RunDir, RunLockedError
 
 from .helpers import make_trainer, read_curve, smoke_cfg
 

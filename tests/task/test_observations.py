@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import torch
 
+from lca.config import compose
 from lca.task import observations
 from lca.task.state import RobotState
 
@@ -17,6 +18,18 @@ J = 29
 K = 5
 FRAME = 2 * J + 6  # joint_pos, joint_vel, base_ang_vel, projected_gravity
 # Paper table "Proprioception observation terms": (slice in a frame, noise half-width, scale)
+OBS = compose(["scale=smoke"]).task.observations  # the declared terms of conf/task
+
+
+def history_frame(state, default, terms, rng):
+    """A history frame of `state` alone (the proprioception terms read nothing else)."""
+    n = len(state.joint_pos)
+    inputs = observations.ObsInputs(
+        state, default, np.zeros((n, 3)), np.zeros((n, J)), np.zeros((n, 2)), np.zeros(n, bool)
+    )
+    return observations.build(inputs, terms, rng)
+
+
 PAPER_TERMS = {
     "joint_pos": (slice(0, J), 0.01, 1.0),
     "joint_vel": (slice(J, 2 * J), 1.5, 0.05),
@@ -53,7 +66,7 @@ def random_state(n: int, seed: int = 0) -> RobotState:
 
 # ---- terms ---------------------------------------------------------------------------------
 def test_history_terms_match_the_paper_table():
-    terms = observations.history_terms(J)
+    terms = observations.history_terms(OBS, J)
     assert [t.name for t in terms] == list(PAPER_TERMS)
     for t in terms:
         sl, noise, scale = PAPER_TERMS[t.name]
@@ -63,7 +76,7 @@ def test_history_terms_match_the_paper_table():
 
 
 def test_current_terms_layout():
-    terms = observations.current_terms(J)
+    terms = observations.current_terms(OBS, J)
     assert [(t.name, t.dim) for t in terms] == [
         ("velocity_commands", 3),
         ("actions", J),
@@ -76,7 +89,7 @@ def test_current_terms_layout():
 def test_noiseless_frame_by_hand():
     state = random_state(3)
     default = np.linspace(-0.5, 0.5, J)
-    frame = observations.history_frame(state, default, observations.history_terms(J), None)
+    frame = history_frame(state, default, observations.history_terms(OBS, J), None)
     assert frame.shape == (3, FRAME)
     np.testing.assert_allclose(frame[:, :J], state.joint_pos - default)
     np.testing.assert_allclose(frame[:, J : 2 * J], 0.05 * state.joint_vel)
@@ -88,10 +101,10 @@ def test_noisy_frame_differs_by_at_most_noise_times_scale():
     n = 2000
     state = random_state(n, seed=1)
     default = np.zeros(J)
-    terms = observations.history_terms(J)
+    terms = observations.history_terms(OBS, J)
     rng = np.random.default_rng(5)
-    noisy = observations.history_frame(state, default, terms, rng)
-    clean = observations.history_frame(state, default, terms, None)
+    noisy = history_frame(state, default, terms, rng)
+    clean = history_frame(state, default, terms, None)
     for name, (sl, noise, scale) in PAPER_TERMS.items():
         diff = (noisy - clean)[:, sl]
         bound = noise * scale

@@ -51,7 +51,7 @@ def test_joint_mirror_swaps_twins_and_flips_roll_and_yaw(env):
 
 def test_mirroring_twice_is_the_identity(env):
     rng = np.random.default_rng(0)
-    maps = proprioception_mirrors(env.scene.joint_names, history=5)
+    maps = proprioception_mirrors(env.scene.joint_names, env.task_cfg.observations)
     for mirror in maps.values():
         x = rng.normal(size=(4, mirror.perm.size))
         np.testing.assert_array_equal(mirror(mirror(x)), x)
@@ -125,5 +125,6 @@ def test_augment_appends_the_mirror_images(env):
     torch.testing.assert_close(
         aug_obs[env.num_envs :]["height"], torch.flip(obs["height"], dims=[-1])
     )
-    frame = sum(t.dim for t in observations.history_terms(env.num_actions))
+    declared = observations.history_terms(env.task_cfg.observations, env.num_actions)
+    frame = sum(t.dim for t in declared)
     assert aug_obs["policy"].shape[1] == obs["policy"].shape[1] > frame

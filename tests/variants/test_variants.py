@@ -56,7 +56,7 @@ def test_variants_from_outside_run_train_evaluate_report(tmp_path) -> None:
         cells,
         "hydra.run.dir=" + str(run),
     ]
-    args += ["+task.rewards.base_yaw_rate_l2=-0.1"]
+    args += ["+task.rewards.base_yaw_rate_l2={weight: -0.1, params: {power: 2.0}}"]
     done = subprocess.run(
         [sys.executable, str(REPO / "run.py"), *args],
         cwd=tmp_path,
@@ -75,3 +75,20 @@ def test_variants_from_outside_run_train_evaluate_report(tmp_path) -> None:
     tex = (run / "report" / "sim_table.tex").read_text()
     assert "Slopes" in tex and "Flat" in tex and "GRU" in tex
     assert (run / "COMPLETE").exists()
+
+
+def test_a_term_declared_with_params_gets_them(example_variants) -> None:
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from lca.task.rewards import compute_rewards, weights_and_params
+
+    rewards = {"base_yaw_rate_l2": {"weight": -1.0, "params": {"power": 3.0}}}
+    weights, params = weights_and_params(rewards)
+    assert weights == {"base_yaw_rate_l2": -1.0} and params == {"base_yaw_rate_l2": {"power": 3.0}}
+    ctx = SimpleNamespace(
+        state=SimpleNamespace(base_ang_vel=np.array([[0.0, 0.0, 2.0]])), command=np.zeros((1, 3))
+    )
+    total, _ = compute_rewards(ctx, weights, dt=1.0, params=params)
+    assert total == pytest.approx([-8.0])  # |2|^3, not the default square

@@ -103,6 +103,7 @@ class Registry:
 
 TILES = Registry("terrain tile")  # name -> f(lx, ly, terrain, difficulty, rng) -> (heights, params)
 EVAL_TERRAINS = Registry("evaluation terrain")  # name -> {tile: weight}
+OBS_TERMS = Registry("observation term")  # name -> ObsTerm(dim, value) (task.observations)
 REWARD_TERMS = Registry("reward term")  # name -> f(RewardContext) -> (N,) unweighted
 ACTORS = Registry("actor kind")  # name -> ActorSpec (learn.variants)
 ENCODERS = Registry("encoder kind")  # name -> rsl-rl encoder cfg "type"

@@ -4,9 +4,12 @@ commands, rewards and their curricula, terminations)."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
+
+from omegaconf import MISSING
 
 from lca.config.errors import check_range, require
-from lca.config.registry import REWARD_TERMS
+from lca.config.registry import OBS_TERMS, REWARD_TERMS
 
 
 @dataclass
@@ -27,8 +30,36 @@ class RandomizationConfig:
 
 
 @dataclass
+class ObsTermConfig:
+    name: str = MISSING  # a registered observation term (lca.task.observations)
+    scale: Any = 1.0  # a number, or one per dimension
+    noise: float = 0.0  # half-width of uniform noise on the raw value (actor only)
+    clip: float | None = None  # |scaled value| bound; None: unbounded
+
+
+def _paper_proprioception() -> list[ObsTermConfig]:
+    return [
+        ObsTermConfig("joint_pos", 1.0, 0.01),
+        ObsTermConfig("joint_vel", 0.05, 1.5),
+        ObsTermConfig("base_ang_vel", 0.25, 0.2),
+        ObsTermConfig("projected_gravity", 1.0, 0.05),
+    ]
+
+
+def _paper_current() -> list[ObsTermConfig]:
+    return [
+        ObsTermConfig("velocity_commands", [2.0, 2.0, 0.25]),
+        ObsTermConfig("actions"),
+        ObsTermConfig("phase"),
+    ]
+
+
+@dataclass
 class ObservationConfig:
     history: int = 5  # K proprioception frames, newest first
+    # the terms of each history frame, in order, and the current terms after the history
+    proprioception: list[ObsTermConfig] = field(default_factory=_paper_proprioception)
+    current: list[ObsTermConfig] = field(default_factory=_paper_current)
     noise: bool = True  # actor observation noise on/off
     height_dropout: float = 0.05  # fraction of actor heightmap cells dropped (set to the mean)
     actor_grid: list[int] = field(default_factory=lambda: [11, 11])
@@ -150,7 +181,9 @@ class TaskConfig:
     randomization: RandomizationConfig = field(default_factory=RandomizationConfig)
     observations: ObservationConfig = field(default_factory=ObservationConfig)
     commands: CommandConfig = field(default_factory=CommandConfig)
-    rewards: dict[str, float] = field(default_factory=dict)
+    # term name -> weight, or {weight: w, params: {...}} (mjlab's form: the term is called as
+    # f(ctx, **params)); names are the registered reward terms (lca.task.rewards)
+    rewards: dict[str, Any] = field(default_factory=dict)
     only_positive_rewards: bool = False  # clip the step's sum (but termination) at 0, always
     reward_curriculum: RewardCurriculumConfig = field(default_factory=RewardCurriculumConfig)
     command_curriculum: CommandCurriculumConfig = field(default_factory=CommandCurriculumConfig)
@@ -164,6 +197,12 @@ class TaskConfig:
         check_range("task.randomization.friction", self.randomization.friction)
         check_range("task.randomization.added_base_mass", self.randomization.added_base_mass, -1e9)
         require(self.observations.history >= 1, "task.observations.history", "must be >= 1")
+        for part in ("proprioception", "current"):
+            for i, term in enumerate(getattr(self.observations, part)):
+                key = f"task.observations.{part}[{i}]"
+                OBS_TERMS.check(term.name, f"{key}.name")
+                require(term.noise >= 0, f"{key}.noise", f"must be >= 0, got {term.noise}")
+                require(term.clip is None or term.clip > 0, f"{key}.clip", "must be > 0 or null")
         require(
             0 <= self.observations.height_dropout < 1, "task.observations.height_dropout", "[0, 1)"
         )
@@ -172,5 +211,17 @@ class TaskConfig:
         require(
             0 <= self.commands.standing_fraction <= 1, "task.commands.standing_fraction", "[0, 1]"
         )
-        for name in self.rewards:
-            REWARD_TERMS.check(name, f"task.rewards.{name}")
+        for name, entry in self.rewards.items():
+            key = f"task.rewards.{name}"
+            REWARD_TERMS.check(name, key)
+            if isinstance(entry, dict):
+                extra = sorted(set(entry) - {"weight", "params"})
+                require(not extra, key, f"unknown field(s) {extra}; allowed: weight, params")
+                require("weight" in entry, key, "needs a weight")
+                require(isinstance(entry.get("params", {}), dict), f"{key}.params", "a mapping")
+                entry = entry["weight"]
+            require(
+                isinstance(entry, int | float) and not isinstance(entry, bool),
+                key,
+                f"the weight must be a number, got {entry!r}",
+            )

@@ -18,8 +18,7 @@ MAP_GROUPS = ("height", "critic_height")
 def _mirrors(env) -> dict[str, tuple[torch.Tensor, torch.Tensor]]:
     cached = getattr(env, "_torch_mirrors", None)
     if cached is None:
-        history = int(env.task_cfg.observations.history)
-        maps = symmetry.proprioception_mirrors(env.scene.joint_names, history)
+        maps = symmetry.proprioception_mirrors(env.scene.joint_names, env.task_cfg.observations)
         cached = {
             k: (
                 torch.as_tensor(m.perm, device=env.device),

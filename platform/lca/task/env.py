@@ -23,7 +23,7 @@ from lca.sim.scene import Scene, build_scene
 from lca.task import heightmap, observations, perception
 from lca.task.actions import action_scales, joint_ids
 from lca.task.commands import VelocityCommand, gait_phase
-from lca.task.rewards import RewardContext, compute_rewards
+from lca.task.rewards import RewardContext, compute_rewards, weights_and_params
 from lca.task.state import (
     ContactAccumulator,
     RobotState,
@@ -81,7 +81,7 @@ class LocomotionEnv(VecEnv):
         lower, upper = self.scene.model.jnt_range[1 : 1 + self.num_actions].T
         mid, half = (lower + upper) / 2, (upper - lower) / 2 * task.reward_params.soft_limit_factor
         self.joint_lower, self.joint_upper = mid - half, mid + half
-        self.weights = {k: float(v) for k, v in task.rewards.items()}
+        self.weights, self.reward_term_params = weights_and_params(task.rewards)
         # the reward curriculum's knobs (lca.learn.reward_curriculum); the paper's: 1, False
         self.penalty_scale = 1.0
         self.only_positive = bool(task.only_positive_rewards)
@@ -90,8 +90,8 @@ class LocomotionEnv(VecEnv):
         self.height_noise = float(cfg.difficulty.height_noise) if task.observations.noise else 0.0
 
         obs = task.observations
-        self.history_terms = observations.history_terms(self.num_actions)
-        self.current_terms = observations.current_terms(self.num_actions)
+        self.history_terms = observations.history_terms(obs, self.num_actions)
+        self.current_terms = observations.current_terms(obs, self.num_actions)
         frame_dim = sum(t.dim for t in self.history_terms)
         self.history = observations.History(self.num_envs, obs.history, frame_dim)
         self.critic_history = observations.History(self.num_envs, obs.history, frame_dim)
@@ -163,7 +163,13 @@ class LocomotionEnv(VecEnv):
 
         ctx = self._reward_context(state, terminated)
         reward, terms = compute_rewards(
-            ctx, self.weights, self.dt, self.only_positive, self.penalty_scale, self.scaled_terms
+            ctx,
+            self.weights,
+            self.dt,
+            self.only_positive,
+            self.penalty_scale,
+            self.scaled_terms,
+            self.reward_term_params,
         )
         for name, value in terms.items():
             self.episode_sums[name] += value
@@ -262,27 +268,27 @@ class LocomotionEnv(VecEnv):
 
     def _observe(self, state: RobotState, reset_ids: np.ndarray | None = None) -> TensorDict:
         n = self.num_envs
-        clean = observations.history_frame(state, self.default_joint_pos, self.history_terms, None)
-        frame = (
-            observations.history_frame(state, self.default_joint_pos, self.history_terms, self.rng)
-            if self.task_cfg.observations.noise
-            else clean
+        inputs = observations.ObsInputs(
+            state,
+            self.default_joint_pos,
+            self.commands.value,
+            self.action,
+            self._phase(),
+            self.commands.standing,
         )
+        noisy = self.task_cfg.observations.noise
+        clean = observations.build(inputs, self.history_terms, None)
+        frame = observations.build(inputs, self.history_terms, self.rng) if noisy else clean
         self.history.push(frame)
         self.critic_history.push(clean)
         fresh = np.arange(n) if reset_ids is None else reset_ids
         self.history.fill(fresh, frame)
         self.critic_history.fill(fresh, clean)
-
-        standing = self.commands.standing
-        current = np.concatenate(
-            [
-                self.commands.value * np.array([2.0, 2.0, 0.25]),
-                self.action,
-                observations.phase_features(self._phase(), standing),
-            ],
-            axis=1,
-        )
+        current = observations.build(inputs, self.current_terms, None)
+        if noisy and any(t.noise > 0 for t in self.current_terms):
+            actor_current = observations.build(inputs, self.current_terms, self.rng)
+        else:
+            actor_current = current
         self._state = state
         yaw = yaw_of(state.base_quat)
         actor_map = self._actor_map(state, yaw)
@@ -291,7 +297,7 @@ class LocomotionEnv(VecEnv):
         )
         critic_map = heightmap.normalise(critic_raw)
         groups = {
-            "policy": np.concatenate([self.history.flat(), current], axis=1),
+            "policy": np.concatenate([self.history.flat(), actor_current], axis=1),
             "height": actor_map.reshape(n, 1, *self.actor_grid),
             "critic": np.concatenate(
                 [self.critic_history.flat(), current, state.base_lin_vel_world], axis=1

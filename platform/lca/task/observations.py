@@ -1,62 +1,84 @@
 """Observation terms (paper table "Proprioception observation terms") and their history.
 
-Noise is added to the raw value, then the scale applied (IsaacLab's order). The history
-holds K frames of (joint_pos, joint_vel, base_ang_vel, projected_gravity), newest first.
+Terms are declared in task.observations (name, scale, noise, clip) and registered here by
+name; `build` serves the env and `lca.describe` alike. Noise is added to the raw value, then
+the scale applied (IsaacLab's order). The history holds K frames of the proprioception terms
+(the paper's: joint_pos, joint_vel, base_ang_vel, projected_gravity), newest first.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
+from lca.config.registry import OBS_TERMS
 from lca.task.state import RobotState
 
 
 @dataclass(frozen=True)
 class Term:
+    """One declared observation term (task.observations), with its dimension resolved."""
+
     name: str
     dim: int
     scale: float | tuple[float, ...] = 1.0
     noise: float = 0.0  # half-width of uniform noise on the raw value
+    clip: float | None = None
 
 
-def history_terms(num_joints: int) -> tuple[Term, ...]:
-    return (
-        Term("joint_pos", num_joints, 1.0, 0.01),
-        Term("joint_vel", num_joints, 0.05, 1.5),
-        Term("base_ang_vel", 3, 0.25, 0.2),
-        Term("projected_gravity", 3, 1.0, 0.05),
-    )
+@dataclass
+class ObsInputs:
+    """What observation terms read: the robot state and the task's signals of this step."""
+
+    state: RobotState
+    default_joint_pos: np.ndarray
+    command: np.ndarray  # (N, 3)
+    action: np.ndarray  # (N, J)
+    phase: np.ndarray  # (N, 2)
+    standing: np.ndarray  # (N,) bool
 
 
-def current_terms(num_joints: int) -> tuple[Term, ...]:
-    return (
-        Term("velocity_commands", 3, (2.0, 2.0, 0.25)),
-        Term("actions", num_joints),
-        Term("phase", 2),  # (sin, cos) of 2 pi phi; zeros while standing
-    )
+@dataclass(frozen=True)
+class ObsTerm:
+    dim: Callable[[int], int]  # of the joint count
+    value: Callable[[ObsInputs], np.ndarray]  # (N, dim), raw (before noise and scale)
 
 
-def history_frame(
-    state: RobotState,
-    default_joint_pos: np.ndarray,
-    terms: tuple[Term, ...],
-    rng: np.random.Generator | None,
+def terms(declared, num_joints: int) -> tuple[Term, ...]:
+    """The declared terms (task.observations.proprioception or .current) with dimensions."""
+    out = []
+    for t in declared:
+        scale = (
+            tuple(float(x) for x in t.scale) if not isinstance(t.scale, int | float) else t.scale
+        )
+        out.append(Term(t.name, OBS_TERMS[t.name].dim(num_joints), scale, t.noise, t.clip))
+    return tuple(out)
+
+
+def history_terms(obs_cfg, num_joints: int) -> tuple[Term, ...]:
+    return terms(obs_cfg.proprioception, num_joints)
+
+
+def current_terms(obs_cfg, num_joints: int) -> tuple[Term, ...]:
+    return terms(obs_cfg.current, num_joints)
+
+
+def build(
+    inputs: ObsInputs, declared: tuple[Term, ...], rng: np.random.Generator | None
 ) -> np.ndarray:
-    """One (N, D) frame; `rng=None` gives the noiseless (critic) version."""
-    raw = {
-        "joint_pos": state.joint_pos - default_joint_pos,
-        "joint_vel": state.joint_vel,
-        "base_ang_vel": state.base_ang_vel,
-        "projected_gravity": state.projected_gravity,
-    }
+    """(N, D): each term's raw value, plus noise (unless `rng` is None: the critic's clean
+    version), times its scale, clipped; noise before scale, as IsaacLab does."""
     parts = []
-    for term in terms:
-        value = raw[term.name]
+    for term in declared:
+        value = OBS_TERMS[term.name].value(inputs)
         if rng is not None and term.noise > 0:
             value = value + rng.uniform(-term.noise, term.noise, value.shape)
-        parts.append(value * np.asarray(term.scale))
+        value = value * np.asarray(term.scale)
+        if term.clip is not None:
+            value = np.clip(value, -term.clip, term.clip)
+        parts.append(value)
     return np.concatenate(parts, axis=1)
 
 
@@ -83,3 +105,17 @@ class History:
     def flat(self) -> np.ndarray:
         """(N, K*D), term-major within each frame, newest frame first."""
         return self.buffer.reshape(self.buffer.shape[0], -1)
+
+
+def _register(name: str, dim: Callable[[int], int], value: Callable[[ObsInputs], np.ndarray]):
+    OBS_TERMS.register(name)(ObsTerm(dim, value))
+
+
+_register("joint_pos", lambda j: j, lambda o: o.state.joint_pos - o.default_joint_pos)
+_register("joint_vel", lambda j: j, lambda o: o.state.joint_vel)
+_register("base_ang_vel", lambda j: 3, lambda o: o.state.base_ang_vel)
+_register("projected_gravity", lambda j: 3, lambda o: o.state.projected_gravity)
+_register("velocity_commands", lambda j: 3, lambda o: o.command)
+_register("actions", lambda j: j, lambda o: o.action)
+# (sin, cos) of 2 pi phi of the left foot; zeros while standing (standing detection)
+_register("phase", lambda j: 2, lambda o: phase_features(o.phase, o.standing))

@@ -195,6 +195,18 @@ for _term in (
     REWARD_TERMS.register(_term.__name__)(_term)
 
 
+def weights_and_params(rewards) -> tuple[dict[str, float], dict[str, dict]]:
+    """`task.rewards` (name -> weight or {weight, params}) as weights and per-term params."""
+    weights, params = {}, {}
+    for name, entry in rewards.items():
+        if isinstance(entry, int | float):
+            weights[name] = float(entry)
+        else:
+            weights[name] = float(entry["weight"])
+            params[name] = dict(entry.get("params") or {})
+    return weights, params
+
+
 def compute_rewards(
     ctx: RewardContext,
     weights: dict[str, float],
@@ -202,6 +214,7 @@ def compute_rewards(
     only_positive: bool = False,
     penalty_scale: float = 1.0,
     scaled_terms: frozenset[str] | None = None,
+    params: dict[str, dict] | None = None,
 ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Total reward and each weighted term, (N,). Terms are per second of simulated time,
     scaled by the policy step `dt`, so weights do not depend on the control rate.
@@ -212,8 +225,9 @@ def compute_rewards(
     before adding that penalty: while a young policy's penalties outweigh its rewards, living
     longer would otherwise cost more than falling early."""
     terms = {}
+    params = params or {}
     for name, weight in weights.items():
-        value = weight * REWARD_TERMS[name](ctx) * dt
+        value = weight * REWARD_TERMS[name](ctx, **params.get(name, {})) * dt
         if penalty_scale != 1.0 and (scaled_terms is None or name in scaled_terms):
             value = np.where(value < 0, penalty_scale * value, value)
         terms[name] = value

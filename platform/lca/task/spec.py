@@ -9,6 +9,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from lca.sim.robot import build_robot_spec
 from lca.task import observations
+from lca.task.rewards import weights_and_params
 from lca.task.terminations import TERMINATIONS
 
 
@@ -28,8 +29,8 @@ def describe_task(cfg: DictConfig) -> dict:
     num_joints = sum(1 for j in spec.joints if j.type == mujoco.mjtJoint.mjJNT_HINGE)
     k = task.observations.history
     noisy = bool(task.observations.noise)
-    hist = observations.history_terms(num_joints)
-    current = observations.current_terms(num_joints)
+    hist = observations.history_terms(task.observations, num_joints)
+    current = observations.current_terms(task.observations, num_joints)
     policy_terms = [_term(t, k, noisy) for t in hist] + [_term(t) for t in current]
     critic_terms = [_term(t, k, noisy=False) for t in hist] + [_term(t) for t in current]
     critic_terms.append({"name": "base_lin_vel_world", "dim": 3, "scale": 1.0, "noise": 0.0})
@@ -67,7 +68,8 @@ def describe_task(cfg: DictConfig) -> dict:
     return {
         "observations": described,
         "actions": {"dim": num_joints, "scale": task.action_scale, "clip": task.action_clip},
-        "rewards": {k: float(v) for k, v in task.rewards.items()},
+        "rewards": weights_and_params(task.rewards)[0],
+        "reward_term_params": weights_and_params(task.rewards)[1],
         "only_positive_rewards": bool(task.only_positive_rewards),
         "reward_params": OmegaConf.to_container(task.reward_params),
         "commands": OmegaConf.to_container(task.commands),

@@ -66,12 +66,14 @@ def _term_mirror(name: str, joints: Mirror) -> Mirror:
     return Mirror(np.arange(sign.size), sign)
 
 
-def proprioception_mirrors(joint_names: list[str], history: int) -> dict[str, Mirror]:
-    """Mirrors of the flat groups `policy` and `critic`, in the env's layout."""
+def proprioception_mirrors(joint_names: list[str], obs_cfg) -> dict[str, Mirror]:
+    """Mirrors of the flat groups `policy` and `critic`, in the env's layout
+    (task.observations: its history length and declared terms)."""
     joints = joint_mirror(joint_names)
     n = len(joint_names)
-    frame = [_term_mirror(t.name, joints) for t in observations.history_terms(n)]
-    current = [_term_mirror(t.name, joints) for t in observations.current_terms(n)]
+    history = int(obs_cfg.history)
+    frame = [_term_mirror(t.name, joints) for t in observations.history_terms(obs_cfg, n)]
+    current = [_term_mirror(t.name, joints) for t in observations.current_terms(obs_cfg, n)]
     policy = _concat(frame * history + current)
     critic = _concat(frame * history + current + [_term_mirror("base_lin_vel_world", joints)])
     return {"policy": policy, "critic": critic, "actions": joints}

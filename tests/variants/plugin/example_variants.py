@@ -23,9 +23,9 @@ def slopes_tile(lx, ly, cfg, difficulty, rng):
     return SLOPE_GRADE * np.clip(ring, 0.0, None), {"grade": SLOPE_GRADE}
 
 
-def base_yaw_rate_l2(c) -> np.ndarray:
-    """Squared yaw rate of the base (rad/s)^2: a turning penalty."""
-    return c.state.base_ang_vel[:, 2] ** 2
+def base_yaw_rate_l2(c, power: float = 2.0) -> np.ndarray:
+    """|yaw rate|^power of the base: a turning penalty (power is a per-term parameter)."""
+    return np.abs(c.state.base_ang_vel[:, 2]) ** power
 
 
 def register() -> None:
