@@ -9,6 +9,8 @@ deployment perception pipeline (depth cameras -> filtered 11 x 11 map).
 
 from __future__ import annotations
 
+import copy
+import time
 from pathlib import Path
 
 import numpy as np
@@ -17,12 +19,15 @@ import torch
 from omegaconf import DictConfig
 
 from lca.config import load_option
+from lca.evaluate.clips import Clip, clip_fps, film, gl_missing, perception_of, record, save
 from lca.evaluate.policy import final_checkpoint, load_policy
 from lca.evaluate.protocol import trial_config
 from lca.learn import curriculum
 from lca.learn.rundir import RunDir, atomic_write
 from lca.sim.hardware import HardwareTask, build_task
 from lca.task.env import LocomotionEnv
+
+HARDWARE_CLIP_S = 12.0  # s at most of a hardware task's clip (eval.videos)
 
 
 def task_config(cfg: DictConfig) -> DictConfig:
@@ -88,4 +93,34 @@ def _run_hardware(run_dir: Path, cfg: DictConfig, log) -> pd.DataFrame:
             log(f"[lca] hardware {run_dir.name} {name}: {int(trials.success.sum())}/{len(trials)}")
     result = pd.concat(frames, ignore_index=True)
     atomic_write(run_dir / "hardware.csv", result.to_csv(index=False))
+    if cfg.eval.videos and not gl_missing(run_dir.name, log):
+        for name in c.hardware.tasks:
+            t0 = time.perf_counter()
+            clip = hardware_clip(cfg, name, checkpoint, HARDWARE_CLIP_S)
+            path = save(clip.frames, clip.fps, run_dir / "clips" / f"hw_{name}.mp4")
+            if log:
+                log(
+                    f"[lca] clip {run_dir.name} {path.name}: {len(clip.frames)} frames "
+                    f"in {time.perf_counter() - t0:.1f} s"
+                )
     return result
+
+
+def hardware_clip(cfg: DictConfig, name: str, checkpoint: Path, seconds: float) -> Clip:
+    """The first trial of hardware task `name` (the protocol's settings, one trial), filmed
+    until it passes the goal line (and a second more), falls, or `seconds` run out."""
+    one = copy.deepcopy(cfg)
+    one.hardware.trials = 1
+    c = task_config(one)
+    task, scene = build_task(c, name)
+    env = LocomotionEnv(c, scene=scene)
+    env.set_perception(perception_of(cfg))
+    env.reseed(c.eval.seed)
+    policy = load_policy(c, env, checkpoint)
+
+    def ended(metrics: dict) -> str:
+        return "goal reached" if metrics["base_pos"][0, 0] >= task.goal_x else ""
+
+    rec = record(env, policy, max(1, round(seconds * clip_fps(env.dt))), ended)
+    frames = film(c, task.terrain, rec, f"hardware: {name}", task.decorate)
+    return Clip(frames, rec.fps, task.terrain, c)
