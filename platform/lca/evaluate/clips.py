@@ -163,19 +163,37 @@ def clip_config(cfg: DictConfig, seconds: float) -> DictConfig:
 
 
 @dataclass
+class Setting:
+    """What a clip films: one unit's env, seeded, with the policy loaded."""
+
+    cfg: DictConfig  # the setting's config (one unit)
+    env: LocomotionEnv
+    policy: Callable
+    label: str
+    terrain: Terrain  # the simulated one, whole
+    decorate: render.Decorate | None = None  # task objects of a hardware scene
+    ended: Callable[[dict], str] | None = None  # see `record`
+
+
+@dataclass
 class Clip:
     frames: list[np.ndarray]
     fps: float
-    terrain: Terrain  # the simulated one, whole
-    cfg: DictConfig  # the setting filmed
 
 
-def cell_clip(cfg: DictConfig, cell, checkpoint: Path, seconds: float) -> Clip:
-    """One unit of evaluation `cell` for `seconds`, seeded like the cell's first round."""
+def cell_setting(cfg: DictConfig, cell, checkpoint: Path, seconds: float) -> Setting:
+    """One unit of evaluation `cell`, seeded like the cell's first round, for `seconds`."""
     c = clip_config(cell_config(cfg, cell), seconds)
     env = LocomotionEnv(c)
     env.set_perception(perception_of(cfg))
     policy = load_policy(c, env, checkpoint)
     env.reseed(round_seed(c.eval.seed, cell, 0))
-    rec = record(env, policy, max(1, round(seconds * clip_fps(env.dt))))
-    return Clip(film(c, env.scene.terrain, rec, cell_name(cell)), rec.fps, env.scene.terrain, c)
+    return Setting(c, env, policy, cell_name(cell), env.scene.terrain)
+
+
+def shoot(setting: Setting, seconds: float) -> Clip:
+    """`seconds` of the setting (less if a hardware trial ends first), filmed."""
+    env = setting.env
+    rec = record(env, setting.policy, max(1, round(seconds * clip_fps(env.dt))), setting.ended)
+    frames = film(setting.cfg, setting.terrain, rec, setting.label, setting.decorate)
+    return Clip(frames, rec.fps)

@@ -19,7 +19,7 @@ import torch
 from omegaconf import DictConfig
 
 from lca.config import load_option
-from lca.evaluate.clips import Clip, clip_fps, film, gl_missing, perception_of, record, save
+from lca.evaluate.clips import Setting, gl_missing, perception_of, save, shoot
 from lca.evaluate.policy import final_checkpoint, load_policy
 from lca.evaluate.protocol import trial_config
 from lca.learn import curriculum
@@ -96,7 +96,7 @@ def _run_hardware(run_dir: Path, cfg: DictConfig, log) -> pd.DataFrame:
     if cfg.eval.videos and not gl_missing(run_dir.name, log):
         for name in c.hardware.tasks:
             t0 = time.perf_counter()
-            clip = hardware_clip(cfg, name, checkpoint, HARDWARE_CLIP_S)
+            clip = shoot(hardware_setting(cfg, name, checkpoint), HARDWARE_CLIP_S)
             path = save(clip.frames, clip.fps, run_dir / "clips" / f"hw_{name}.mp4")
             if log:
                 log(
@@ -106,9 +106,9 @@ def _run_hardware(run_dir: Path, cfg: DictConfig, log) -> pd.DataFrame:
     return result
 
 
-def hardware_clip(cfg: DictConfig, name: str, checkpoint: Path, seconds: float) -> Clip:
-    """The first trial of hardware task `name` (the protocol's settings, one trial), filmed
-    until it passes the goal line (and a second more), falls, or `seconds` run out."""
+def hardware_setting(cfg: DictConfig, name: str, checkpoint: Path) -> Setting:
+    """The first trial of hardware task `name` (the protocol's settings, one trial), ending
+    when it passes the goal line."""
     one = copy.deepcopy(cfg)
     one.hardware.trials = 1
     c = task_config(one)
@@ -121,6 +121,5 @@ def hardware_clip(cfg: DictConfig, name: str, checkpoint: Path, seconds: float) 
     def ended(metrics: dict) -> str:
         return "goal reached" if metrics["base_pos"][0, 0] >= task.goal_x else ""
 
-    rec = record(env, policy, max(1, round(seconds * clip_fps(env.dt))), ended)
-    frames = film(c, task.terrain, rec, f"hardware: {name}", task.decorate)
-    return Clip(frames, rec.fps, task.terrain, c)
+    label = f"hardware: {name}"
+    return Setting(c, env, policy, label, task.terrain, task.decorate, ended)

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from omegaconf import DictConfig, OmegaConf
 
-from lca.evaluate.clips import cell_clip, gl_missing, save
+from lca.evaluate.clips import cell_setting, gl_missing, save, shoot
 from lca.evaluate.policy import final_checkpoint
 from lca.evaluate.protocol import cell_config, cell_name
 from lca.learn.rundir import atomic_write
@@ -83,8 +83,9 @@ def make_media(run_dir: Path, cfg: DictConfig, log=print) -> list[Path]:
         name = cell_name(cell)
         t1 = time.perf_counter()
         if rendered:
-            clip = cell_clip(cfg, cell, checkpoint, seconds)
-            c, terrain = clip.cfg, clip.terrain
+            setting = cell_setting(cfg, cell, checkpoint, seconds)
+            clip = shoot(setting, seconds)
+            c, terrain = setting.cfg, setting.terrain
             written.append(save(clip.frames, clip.fps, run_dir / CLIPS / f"{name}.mp4"))
         else:
             c = cell_config(cfg, cell)

@@ -86,6 +86,8 @@ def write_clip(path: Path, frames: list[np.ndarray], fps: float) -> Path:
     it (same stem). Returns the file written; it appears complete or not at all."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    if path.suffix.lower() == ".gif":
+        return write_gif(path, frames, fps)
     tmp = path.with_name(f".{path.stem}.tmp{path.suffix}")
     try:
         writer = imageio.get_writer(
@@ -113,6 +115,7 @@ def write_clip(path: Path, frames: list[np.ndarray], fps: float) -> Path:
 
 def write_gif(path: Path, frames: list[np.ndarray], fps: float) -> Path:
     path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.stem}.tmp.gif")
     iio.imwrite(tmp, np.stack(frames), extension=".gif", duration=1000.0 / fps, loop=0)
     os.replace(tmp, path)
