@@ -19,7 +19,6 @@ import sys
 import time
 from pathlib import Path
 
-import mujoco
 import torch
 from omegaconf import OmegaConf
 
