@@ -1,6 +1,6 @@
 """Clips on disk: an overlay of the command against the measured velocity on every frame,
-encoded as H.264 MP4 by imageio-ffmpeg's own ffmpeg binary, or as a GIF where that encoder
-cannot run.
+encoded as H.264 MP4 by imageio-ffmpeg's own ffmpeg binary, or as a GIF (Pillow, through
+imageio) where that binary cannot run.
 """
 
 from __future__ import annotations
@@ -9,7 +9,6 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-import imageio.v2 as imageio
 import imageio.v3 as iio
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
@@ -82,35 +81,44 @@ def _chart(draw: ImageDraw.ImageDraw, size: tuple[int, int], history: list[Telem
 
 
 def write_clip(path: Path, frames: list[np.ndarray], fps: float) -> Path:
-    """`frames` as an MP4 at `path`, or, if imageio-ffmpeg cannot encode here, as a GIF beside
-    it (same stem). Returns the file written; it appears complete or not at all."""
+    """`frames` as an MP4 at `path`, or, if imageio-ffmpeg cannot encode here (or `path` ends
+    in .gif), as a GIF beside it (same stem). Returns the file written; it appears complete
+    or not at all."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     if path.suffix.lower() == ".gif":
         return write_gif(path, frames, fps)
     tmp = path.with_name(f".{path.stem}.tmp{path.suffix}")
     try:
-        writer = imageio.get_writer(
-            tmp,
-            format="FFMPEG",
-            mode="I",
-            fps=fps,
-            codec="libx264",
-            pixelformat="yuv420p",  # what every browser decodes
-            quality=7,
-            macro_block_size=2,
-            ffmpeg_log_level="error",
-            output_params=["-movflags", "+faststart"],  # playable while loading
-        )
-    except (ImportError, RuntimeError, OSError):
+        _encode(tmp, frames, fps)
+    except (ImportError, RuntimeError, OSError):  # no encoder binary here: a GIF instead
+        tmp.unlink(missing_ok=True)
         return write_gif(path.with_suffix(".gif"), frames, fps)
-    try:
-        for frame in frames:
-            writer.append_data(frame)
-    finally:
-        writer.close()
     os.replace(tmp, path)
     return path
+
+
+def _encode(path: Path, frames: list[np.ndarray], fps: float) -> None:
+    import imageio_ffmpeg  # ships its own ffmpeg binary
+
+    height, width = frames[0].shape[:2]
+    encoder = imageio_ffmpeg.write_frames(
+        str(path),
+        (width, height),
+        fps=fps,
+        codec="libx264",
+        pix_fmt_out="yuv420p",  # what every browser decodes
+        quality=7,
+        macro_block_size=2,
+        ffmpeg_log_level="error",
+        output_params=["-movflags", "+faststart"],  # playable while it loads
+    )
+    encoder.send(None)  # starts ffmpeg; raises here if it cannot run
+    try:
+        for frame in frames:
+            encoder.send(np.ascontiguousarray(frame))
+    finally:
+        encoder.close()
 
 
 def write_gif(path: Path, frames: list[np.ndarray], fps: float) -> Path:
