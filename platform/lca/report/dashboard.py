@@ -27,6 +27,7 @@ PAGE = Template(
  figure { display: inline-block; margin: 0 8px 8px 0; vertical-align: top; }
  figcaption { font-size: 0.85em; text-align: center; color: #555; }
  h3 { font-size: 1em; margin: 1em 0 0.4em; }
+ figure.terrain img { width: 560px; }
 </style></head><body>
 <h1>lca: architecture ablations for humanoid locomotion</h1>
 {% if note %}<p id="note" class="note">{{ note }}: these runs only check that the pipeline
