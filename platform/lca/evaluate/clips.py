@@ -73,11 +73,14 @@ def perception_of(cfg: DictConfig) -> bool:
 
 @torch.inference_mode()
 def record(
-    env: LocomotionEnv, policy, frames: int, ended: Callable[[dict], str] | None = None
+    env: LocomotionEnv, policy, frames: int, goal: Callable[[dict], bool] | None = None
 ) -> Recording:
-    """Unit 0 of `env` from a reset, `frames` frames at `clip_fps`. A fall restarts its
-    episode under a banner, or, with `ended`, ends the recording; `ended(metrics)` returns a
-    note when the unit is done (a hardware trial past its goal)."""
+    """Unit 0 of `env` from a reset, at most `frames` frames at `clip_fps`.
+
+    Without `goal` (an evaluation cell) a fall restarts the unit's episode under a banner.
+    With `goal(metrics)` (a hardware trial) the recording ends AFTER_GOAL_S after the goal is
+    reached, or when the trial falls or runs out of time; the env has already reset the unit
+    then, so its last frame is held, captioned."""
     stride = frame_stride(env.dt)
     rec = Recording(fps=clip_fps(env.dt))
     obs = env.reset_all()
@@ -93,27 +96,27 @@ def record(
         )
 
     capture("")
-    stop_at = None  # frame count at which a finished unit stops being filmed
-    while len(rec) < frames and (stop_at is None or len(rec) < stop_at):
-        fell = False
+    last_frame = frames  # a trial past its goal is filmed a little longer, then stops
+    while len(rec) < last_frame:
+        ended = ""
         for _ in range(stride):
             obs, _, dones, extras = env.step(policy(obs))
             policy.reset(dones.bool())
             steps += 1
             m = extras["metrics"]
-            fell |= bool(m["terminated"][0])
-            if ended is not None and stop_at is None and not fell:
-                done = ended(m)
-                if done:
-                    note, note_frames = done, frames
-                    stop_at = len(rec) + 1 + int(AFTER_GOAL_S * rec.fps)
-        if fell and ended is not None:  # the env already reset the unit: hold the last frame
+            if m["terminated"][0] or (goal is not None and m["time_out"][0]):
+                ended = "fell" if m["terminated"][0] else "time limit"
+                break
+            if goal is not None and last_frame == frames and goal(m):
+                note, note_frames = "goal reached", frames
+                last_frame = min(frames, len(rec) + 1 + int(AFTER_GOAL_S * rec.fps))
+        if ended and goal is not None:
             last = rec.telemetry[-1]
             for _ in range(min(int(HOLD_S * rec.fps), frames - len(rec))):
                 rec.qpos.append(rec.qpos[-1])
-                rec.telemetry.append(Telemetry(last.time_s, last.command, last.velocity, "fell"))
+                rec.telemetry.append(Telemetry(last.time_s, last.command, last.velocity, ended))
             break
-        if fell:
+        if ended:
             note, note_frames = "fell: new episode", int(NOTE_S * rec.fps)
         capture(note if note_frames > 0 else "")
         note_frames -= 1
@@ -172,7 +175,7 @@ class Setting:
     label: str
     terrain: Terrain  # the simulated one, whole
     decorate: render.Decorate | None = None  # task objects of a hardware scene
-    ended: Callable[[dict], str] | None = None  # see `record`
+    goal: Callable[[dict], bool] | None = None  # a hardware trial's goal (see `record`)
 
 
 @dataclass
@@ -194,6 +197,6 @@ def cell_setting(cfg: DictConfig, cell, checkpoint: Path, seconds: float) -> Set
 def shoot(setting: Setting, seconds: float) -> Clip:
     """`seconds` of the setting (less if a hardware trial ends first), filmed."""
     env = setting.env
-    rec = record(env, setting.policy, max(1, round(seconds * clip_fps(env.dt))), setting.ended)
+    rec = record(env, setting.policy, max(1, round(seconds * clip_fps(env.dt))), setting.goal)
     frames = film(setting.cfg, setting.terrain, rec, setting.label, setting.decorate)
     return Clip(frames, rec.fps)

@@ -107,8 +107,8 @@ def _run_hardware(run_dir: Path, cfg: DictConfig, log) -> pd.DataFrame:
 
 
 def hardware_setting(cfg: DictConfig, name: str, checkpoint: Path) -> Setting:
-    """The first trial of hardware task `name` (the protocol's settings, one trial), ending
-    when it passes the goal line."""
+    """The first trial of hardware task `name` (the protocol's settings, one trial); its goal
+    is the task's goal line."""
     one = copy.deepcopy(cfg)
     one.hardware.trials = 1
     c = task_config(one)
@@ -118,8 +118,8 @@ def hardware_setting(cfg: DictConfig, name: str, checkpoint: Path) -> Setting:
     env.reseed(c.eval.seed)
     policy = load_policy(c, env, checkpoint)
 
-    def ended(metrics: dict) -> str:
-        return "goal reached" if metrics["base_pos"][0, 0] >= task.goal_x else ""
+    def goal(metrics: dict) -> bool:
+        return bool(metrics["base_pos"][0, 0] >= task.goal_x)
 
     label = f"hardware: {name}"
-    return Setting(c, env, policy, label, task.terrain, task.decorate, ended)
+    return Setting(c, env, policy, label, task.terrain, task.decorate, goal)
