@@ -8,7 +8,7 @@ import json
 import sys
 from pathlib import Path
 
-BENCHMARKS = ("sim", "env", "train", "learn", "walk", "levers")
+BENCHMARKS = ("sim", "env", "train", "learn", "walk", "levers", "clips")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -4,7 +4,8 @@ with a 0.3 m/s forward command, stopping when the task is completed.
 success = the base passes the task's goal line without a fall within the time limit;
 drift = |lateral base displacement| at completion; precision = mean drift over the
 successful trials. Blind policies run with perception off, the others through the
-deployment perception pipeline (depth cameras -> filtered 11 x 11 map).
+deployment perception pipeline (depth cameras -> filtered 11 x 11 map). With `eval.videos`
+the first trial of each task is also filmed into `clips/hw_<task>.mp4`.
 """
 
 from __future__ import annotations
