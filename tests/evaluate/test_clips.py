@@ -205,7 +205,8 @@ def test_headless_backend_picked_on_import() -> None:
     if sys.platform != "linux" or os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
         pytest.skip("only without a display on Linux")
     found = ctypes.util.find_library
-    expected = "egl" if found("EGL") else "osmesa" if found("OSMesa") else "None"
+    egl = found("EGL") and (found("OpenGL") or found("GL"))
+    expected = "egl" if egl else "osmesa" if found("OSMesa") else "None"
     env = {k: v for k, v in cli_env().items() if k != "MUJOCO_GL"}
     code = "import lca, os; print(os.environ.get('MUJOCO_GL'))"
     out = subprocess.run(
