@@ -2,7 +2,7 @@
 
 A clip films one unit from a tracking camera, with the command and the measured velocity
 drawn over it: an evaluation cell's settings, seeded like the cell's first round, or a
-hardware task's first trial (`lca.evaluate.hardware.hardware_clip`), on the run's final
+hardware task's first trial (`lca.evaluate.hardware.hardware_setting`), on the run's final
 policy. `lca.evaluate.media` makes the clips a run keeps; `lca.play` films any cell or task
 for any length.
 """

@@ -6,7 +6,7 @@ chooses one (`lca/__init__.py`); `gl_unavailable()` says why rendering cannot wo
 A batched scene's heightfield covers the whole tile grid at 1 cm (~10^7 samples), which
 software OpenGL draws at seconds per frame. A render model holds the same robot and task
 objects, so a simulation qpos drives it unchanged, on a window of the terrain around what is
-filmed, at `RENDER_RESOLUTION`, with a checkered ground, a sky and a shadow-casting sun.
+filmed, at `RENDER_RESOLUTION`, with a checkered ground, a sky and a sun (no shadows).
 """
 
 from __future__ import annotations
