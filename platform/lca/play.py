@@ -24,7 +24,7 @@ from omegaconf import OmegaConf
 
 from lca.cli import split_option
 from lca.config import ConfigError
-from lca.config.schema import DIFFICULTIES, EVAL_TERRAINS, HARDWARE_TASKS, EvalCell
+from lca.config.schema import HARDWARE_TASKS, EvalCell, EvalConfig
 from lca.evaluate.clips import Setting, cell_setting, save, shoot
 from lca.evaluate.hardware import hardware_setting
 from lca.evaluate.policy import final_checkpoint, load_run_config
@@ -38,14 +38,17 @@ USAGE = (
 
 
 def parse_cell(text: str):
-    """'stairs-hard' -> the EvalCell (terrain, difficulty); ConfigError naming the choices."""
+    """'stairs-hard' -> the EvalCell (terrain, difficulty), checked as the eval config checks
+    its cells; ConfigError naming the allowed values."""
     terrain, _, difficulty = text.rpartition("-")
-    if terrain not in EVAL_TERRAINS or difficulty not in DIFFICULTIES:
+    cell = EvalCell(terrain or text, difficulty)
+    try:
+        EvalConfig(cells=[cell]).check()
+    except ConfigError as error:
         raise ConfigError(
-            f"cell: unknown '{text}'; allowed: <terrain>-<difficulty> with terrain in "
-            f"{EVAL_TERRAINS} and difficulty in {DIFFICULTIES}, e.g. stairs-hard"
-        )
-    return OmegaConf.structured(EvalCell(terrain, difficulty))
+            f"cell: '{text}' is not <terrain>-<difficulty> (e.g. stairs-hard): {error}"
+        ) from None
+    return OmegaConf.structured(cell)
 
 
 def _one(args: list[str], key: str) -> tuple[str | None, list[str]]:
