@@ -11,13 +11,17 @@ report can be worked out by hand. Golden outputs live in golden/; regenerate the
 
 from __future__ import annotations
 
+import html
 import json
 import os
+import re
 import shutil
+import subprocess
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pytest
 from _cli import REPO, cli_env, run_python  # noqa: F401 (re-exported)
 from omegaconf import OmegaConf
 
@@ -141,3 +145,71 @@ def check_golden(produced: Path, name: str) -> None:
         shutil.copyfile(produced, golden)
     assert golden.is_file(), f"missing {golden}; generate it with LCA_UPDATE_GOLDEN=1"
     assert produced.read_text() == golden.read_text(), f"{produced} differs from {golden}"
+
+
+CHROMIUM = "/usr/bin/chromium"
+CHROMIUM_FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
+
+
+def chromium() -> str:
+    """Chromium's path; skips the test, saying why, where there is none."""
+    if not Path(CHROMIUM).exists() and shutil.which("chromium") is None:
+        pytest.skip(f"no Chromium at {CHROMIUM} or on PATH; cannot render the dashboard")
+    return CHROMIUM if Path(CHROMIUM).exists() else shutil.which("chromium")
+
+
+MEASURE = """<script>
+function lcaMeasure() {
+  const out = [];
+  for (const el of document.querySelectorAll("figure video, figure img")) {
+    const box = el.getBoundingClientRect();
+    out.push({tag: el.tagName, src: el.getAttribute("src"), poster: el.getAttribute("poster"),
+              width: box.width, height: box.height, videoWidth: el.videoWidth ?? null,
+              videoHeight: el.videoHeight ?? null, naturalWidth: el.naturalWidth ?? null});
+  }
+  const pre = document.createElement("pre");
+  pre.id = "lca-measured";
+  pre.textContent = JSON.stringify(out);
+  document.body.appendChild(pre);
+}
+window.addEventListener("load", () => {
+  const videos = [...document.querySelectorAll("video")];
+  Promise.all(videos.map(v => v.readyState >= 1 ? 1 : new Promise(done => {
+    v.addEventListener("loadedmetadata", done);
+    v.addEventListener("error", done);
+  }))).then(lcaMeasure);
+});
+</script>"""
+
+
+def chromium_media(index: Path, profile: Path) -> list[dict]:
+    """Every video and image inside a <figure> of the page `index`, as headless Chromium lays
+    it out once the videos' metadata loaded: tag, src, on-screen width and height, and the
+    decoded size (videoWidth/videoHeight, naturalWidth). The page is measured through a copy
+    beside it (so relative paths resolve the same) with a script added."""
+    measured = index.with_name(f"_measure_{index.name}")
+    measured.write_text(index.read_text().replace("</body>", MEASURE + "</body>"))
+    try:
+        out = subprocess.run(
+            [chromium(), *CHROMIUM_FLAGS, f"--user-data-dir={profile}"]
+            + ["--virtual-time-budget=20000", "--dump-dom", measured.as_uri()],
+            capture_output=True,
+            text=True,
+            timeout=90,
+            check=False,
+        )
+    finally:
+        measured.unlink()
+    assert out.returncode == 0, out.stderr[-3000:]
+    found = re.search(r'<pre id="lca-measured">(.*?)</pre>', out.stdout, re.S)
+    assert found, f"the page never finished loading its media: {out.stdout[-1500:]}"
+    return json.loads(html.unescape(found.group(1)))

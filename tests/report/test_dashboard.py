@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import shutil
 import subprocess
 from html.parser import HTMLParser
 from pathlib import Path
@@ -11,26 +10,11 @@ from urllib.parse import unquote
 import matplotlib.image
 import pytest
 
+from .helpers import CHROMIUM_FLAGS as FLAGS
+from .helpers import chromium as _chromium
 from .helpers import fixture_spec
 
-CHROMIUM = "/usr/bin/chromium"
-FLAGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-]
 POLICIES = ["Blind", "One-Stage MLP", "Two-Stage MLP"]
-
-
-def _chromium() -> str:
-    if not Path(CHROMIUM).exists() and shutil.which("chromium") is None:
-        pytest.skip(f"no Chromium at {CHROMIUM} or on PATH; cannot render the dashboard")
-    return CHROMIUM if Path(CHROMIUM).exists() else shutil.which("chromium")
 
 
 class Dom(HTMLParser):

@@ -9,7 +9,7 @@ import sys
 
 from lca.paths import reports_dir
 
-BENCHMARKS = ("sim", "env", "train", "learn", "walk", "levers")
+BENCHMARKS = ("sim", "env", "train", "learn", "walk", "levers", "clips")
 
 
 def main(argv: list[str] | None = None) -> int:

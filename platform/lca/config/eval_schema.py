@@ -33,10 +33,15 @@ class EvalConfig:
     seed: int = 12345
     bootstrap_resamples: int = 2000
     confidence: float = 0.95
+    videos: bool = True  # after evaluation: a clip per cell and terrain previews (needs GL)
+    video_seconds: float = 4.0  # length of each cell's clip
 
     def check(self) -> None:
         for key in ("units", "episodes", "steps"):
             require(getattr(self, key) >= 1, f"eval.{key}", "must be >= 1")
+        require(
+            self.video_seconds > 0, "eval.video_seconds", f"must be > 0, got {self.video_seconds}"
+        )
         for i, cell in enumerate(self.cells):
             allowed = [
                 *EVAL_TERRAINS.names(),

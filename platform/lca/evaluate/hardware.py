@@ -4,11 +4,14 @@ with a 0.3 m/s forward command, stopping when the task is completed.
 success = the base passes the task's goal line without a fall within the time limit;
 drift = |lateral base displacement| at completion; precision = mean drift over the
 successful trials. Blind policies run with perception off, the others through the
-deployment perception pipeline (depth cameras -> filtered 11 x 11 map).
+deployment perception pipeline (depth cameras -> filtered 11 x 11 map). With `eval.videos`
+the first trial of each task is also filmed into `clips/hw_<task>.mp4`.
 """
 
 from __future__ import annotations
 
+import copy
+import time
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +20,7 @@ import torch
 from omegaconf import DictConfig
 
 from lca.config import load_option
+from lca.evaluate.clips import Setting, gl_missing, perception_of, save, shoot
 from lca.evaluate.policy import final_checkpoint, load_policy
 from lca.evaluate.protocol import trial_config
 from lca.evaluate.rollout import rollout, start
@@ -24,6 +28,8 @@ from lca.learn import curriculum
 from lca.sim.hardware import HardwareTask, build_task
 from lca.store import RunDir, atomic_write
 from lca.task.env import LocomotionEnv
+
+HARDWARE_CLIP_S = 12.0  # s at most of a hardware task's clip (eval.videos)
 
 
 def task_config(cfg: DictConfig) -> DictConfig:
@@ -85,4 +91,33 @@ def _run_hardware(run_dir: Path, cfg: DictConfig, log) -> pd.DataFrame:
             log(f"[lca] hardware {run_dir.name} {name}: {int(trials.success.sum())}/{len(trials)}")
     result = pd.concat(frames, ignore_index=True)
     atomic_write(run_dir / "hardware.csv", result.to_csv(index=False))
+    if cfg.eval.videos and not gl_missing(run_dir.name, log):
+        for name in c.hardware.tasks:
+            t0 = time.perf_counter()
+            clip = shoot(hardware_setting(cfg, name, checkpoint), HARDWARE_CLIP_S)
+            path = save(clip.frames, clip.fps, run_dir / "clips" / f"hw_{name}.mp4")
+            if log:
+                log(
+                    f"[lca] clip {run_dir.name} {path.name}: {len(clip.frames)} frames "
+                    f"in {time.perf_counter() - t0:.1f} s"
+                )
     return result
+
+
+def hardware_setting(cfg: DictConfig, name: str, checkpoint: Path) -> Setting:
+    """The first trial of hardware task `name` (the protocol's settings, one trial); its goal
+    is the task's goal line."""
+    one = copy.deepcopy(cfg)
+    one.hardware.trials = 1
+    c = task_config(one)
+    task, scene = build_task(c, name)
+    env = LocomotionEnv(c, scene=scene)
+    env.set_perception(perception_of(cfg))
+    env.reseed(c.eval.seed)
+    policy = load_policy(c, env, checkpoint)
+
+    def goal(metrics: dict) -> bool:
+        return bool(metrics["base_pos"][0, 0] >= task.goal_x)
+
+    label = f"hardware: {name}"
+    return Setting(c, env, policy, label, task.terrain, task.decorate, goal)

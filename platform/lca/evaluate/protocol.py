@@ -129,9 +129,15 @@ def evaluate_run(run_dir: Path, cfg: DictConfig, log=print) -> pd.DataFrame:
     return collect_episodes(run_dir, cfg)
 
 
+NOT_PROTOCOL = ("videos", "video_seconds")  # eval keys that do not change the results
+
+
 def _discard_stale_rounds(out_dir: Path, ev, log) -> None:
     """Finished rounds are reused only under the same protocol; otherwise start afresh."""
-    settings = json.dumps(OmegaConf.to_container(ev, resolve=True), sort_keys=True)
+    protocol = OmegaConf.to_container(ev, resolve=True)
+    for key in NOT_PROTOCOL:
+        protocol.pop(key, None)
+    settings = json.dumps(protocol, sort_keys=True)
     stamp = out_dir / "protocol.json"
     if out_dir.exists() and (not stamp.exists() or stamp.read_text() != settings):
         if log:

@@ -1,4 +1,4 @@
-"""Evaluate one run directory and write its results files."""
+"""Evaluate one run directory and write its results files, then its clips and previews."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from lca.evaluate.media import make_media
 from lca.evaluate.metrics import summarize
 from lca.evaluate.policy import load_run_config
 from lca.evaluate.protocol import evaluate_run
@@ -28,4 +29,5 @@ def evaluate_and_write(
         ev = cfg.eval
         summary = summarize(episodes, ev.bootstrap_resamples, ev.confidence, ev.seed)
         atomic_write(Path(run_dir) / "summary.csv", summary.to_csv(index=False))
+        make_media(run_dir, cfg, log)  # clips and terrain previews (eval.videos)
     return summary

@@ -1,5 +1,6 @@
 """`python -m lca.hardware run_dir=<dir> [key=value ...]`: run the hardware-style tasks on a
-trained run (writes <run>/hardware.csv) and print the per-task table."""
+trained run (writes <run>/hardware.csv, and with eval.videos a clip per task in <run>/clips/)
+and print the per-task table."""
 
 from __future__ import annotations
 

@@ -13,6 +13,7 @@ from lca.report.collect import POOLED, find_run_dirs, load_run, run_status
 from lca.report.dashboard import hardware_section, write_dashboard
 from lca.report.figures import plot_rewards
 from lca.report.hardware_table import hardware_table
+from lca.report.media import clips_section, terrains_section
 from lca.report.tables import (
     best_mask,
     claim_table,
@@ -24,7 +25,8 @@ from lca.report.tables import (
 
 
 def build_report(paths: list[Path], out_dir: Path) -> Path:
-    """Tables (LaTeX, CSV), the training figure (PNG, PDF) and index.html into `out_dir`.
+    """Tables (LaTeX, CSV), the training figure (PNG, PDF), the runs' clips and terrain
+    previews (`media/`) and index.html into `out_dir`.
 
     Only complete runs count; the others are listed apart with their status. The report is
     built in a temporary folder and then swapped in, so an interrupted build never leaves a
@@ -101,6 +103,16 @@ def _build(run_dirs: list[Path], excluded: pd.DataFrame, out_dir: Path, final: P
         _mark(hw_table, note).to_csv(out_dir / "hardware_table.csv", index=False)
         (out_dir / "hardware_table.tex").write_text(hw_latex)
         hardware_html = hardware_section(hw_table)
+    media = clips_section(runs, out_dir) + "\n" + terrains_section(runs, out_dir)
     write_dashboard(
-        out_dir, runs, text, best, claim, hardware_html, excluded, link_base=final, note=note
+        out_dir,
+        runs,
+        text,
+        best,
+        claim,
+        hardware_html,
+        excluded,
+        link_base=final,
+        note=note,
+        media=media,
     )

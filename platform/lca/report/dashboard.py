@@ -1,4 +1,5 @@
-"""A static HTML dashboard: tables, figures, the claim, and every run with its provenance."""
+"""A static HTML dashboard: tables, figures, the claim, clips and terrains, and every run
+with its provenance."""
 
 from __future__ import annotations
 
@@ -23,6 +24,10 @@ PAGE = Template(
  img { max-width: 100%; }
  code { background: #f4f4f4; padding: 1px 4px; }
  p.note { background: #fde68a; padding: 0.6em 1em; font-weight: bold; }
+ figure { display: inline-block; margin: 0 8px 8px 0; vertical-align: top; }
+ figcaption { font-size: 0.85em; text-align: center; color: #555; }
+ h3 { font-size: 1em; margin: 1em 0 0.4em; }
+ figure.terrain img { width: 560px; }
 </style></head><body>
 <h1>lca: architecture ablations for humanoid locomotion</h1>
 {% if note %}<p id="note" class="note">{{ note }}: these runs only check that the pipeline
@@ -38,6 +43,7 @@ Downloads: <a href="sim_table.tex">LaTeX</a>, <a href="sim_table.csv">CSV</a>.</
 random numbers), 95 % paired bootstrap CI. <a href="claim.csv">CSV</a>.</p>
 {{ claim_table }}
 {{ hardware }}
+{{ media }}
 <h2 id="training">Training rewards</h2>
 <img src="training_rewards.png" alt="training rewards">
 <h2 id="runs">Runs</h2>
@@ -126,9 +132,10 @@ def write_dashboard(
     excluded: pd.DataFrame | None = None,
     link_base: Path | None = None,
     note: str = "",
+    media: str = "",
 ) -> Path:
     """index.html in `out_dir`; run links are relative to `link_base` (default out_dir), the
-    folder the page will finally live in."""
+    folder the page will finally live in. `media`: the clips and terrains sections (HTML)."""
     claim_html = (
         claim.round(3).to_html(index=False, table_id="claim-table")
         if not claim.empty
@@ -143,6 +150,7 @@ def write_dashboard(
         hardware=hardware,
         excluded=excluded_section(excluded),
         note=note,
+        media=media,
     )
     path = out_dir / "index.html"
     path.write_text(page)

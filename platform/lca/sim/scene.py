@@ -126,9 +126,12 @@ def build_scene(
     cfg: DictConfig,
     terrain: Terrain | None = None,
     decorate: Callable[[mujoco.MjSpec], None] | None = None,
+    apron: float | None = None,
 ) -> Scene:
     """The compiled model for a composed config: G1 + terrain + physics options + `home`.
-    `decorate(spec)` may add task objects (bodies, joints) before compilation."""
+    `decorate(spec)` may add task objects (bodies, joints) before compilation. `apron`: flat
+    ground around the heightfield (default: the config's around a generated grid, none around
+    a given terrain)."""
     robot_cfg: RobotConfig = cfg.robot
     spec = g1.build_robot_spec(robot_cfg)
     apply_sim_options(spec, cfg.sim)
@@ -139,10 +142,12 @@ def build_scene(
     generated = terrain is None
     terrain = generate(cfg.terrain, cfg.difficulty) if generated else terrain
     # a given terrain (a hardware task) is the whole world; a tile grid gets flat ground around
+    if apron is None:
+        apron = float(cfg.terrain.apron) if generated else 0.0
     add_terrain(
         spec,
         terrain,
-        apron=float(cfg.terrain.apron) if generated else 0.0,
+        apron=apron,
         plane=generated and cfg.terrain.flat_as_plane and not terrain.heights.any(),
     )
     if decorate is not None:

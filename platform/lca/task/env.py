@@ -349,6 +349,11 @@ class LocomotionEnv(VecEnv):
             self._camera_frame = np.where(due, frame, self._camera_frame)
         return self._deployment_map.copy()
 
+    @property
+    def state(self) -> RobotState:
+        """The state the latest observation was made from (reset envs: their new state)."""
+        return self._state
+
     def reseed(self, seed: int) -> None:
         """Restart every random stream (resets, noise, commands) from `seed`."""
         self.rng = np.random.default_rng(seed)
