@@ -4,9 +4,12 @@ a complete run, and calls a policy walking only under the paper's unclipped obje
 from __future__ import annotations
 
 import pandas as pd
+import pytest
 from _cli import SMOKE
 
 from lca.bench import walk
+
+pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
 
 
 def test_until_stops_a_probed_run_that_is_complete(tmp_path):

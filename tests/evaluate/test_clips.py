@@ -25,6 +25,8 @@ from lca.sim.render import HEIGHT, WIDTH, gl_unavailable
 
 from .helpers import REPO, cli_env, train_tiny_run
 
+pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
+
 SHIPPED = REPO / "assets" / "policies" / "blind_flat"
 SECONDS, FPS = 0.8, 25  # 20 frames: the policy runs at 50 Hz, a frame every 2 steps
 VIDEO = [

@@ -17,6 +17,8 @@ from lca.task.env import LocomotionEnv
 
 from .helpers import smoke_cfg
 
+pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
+
 
 def make_trainer(cfg, run_path, scene) -> Trainer:
     return Trainer(cfg, RunDir(run_path), env=LocomotionEnv(cfg, scene=scene))

@@ -21,6 +21,8 @@ from lca.store import RunDir
 
 from .helpers import REPO, SMOKE, run_evaluate_cli, run_module, train_tiny_run
 
+pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
+
 
 @pytest.fixture(scope="module")
 def complete_run(tmp_path_factory):

@@ -18,6 +18,8 @@ from lca.hardware.__main__ import main as hardware_main
 from lca.report.__main__ import main as report_main
 from lca.report.hardware_table import HARDWARE_ROWS, hardware_rows, hardware_table
 
+pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
+
 TASKS = ["stair_ascent", "soft_ledge"]
 
 

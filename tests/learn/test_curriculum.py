@@ -15,6 +15,8 @@ from lca.sim.scene import build_scene
 
 from .helpers import make_trainer, read_curve, smoke_cfg
 
+pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
+
 
 @functools.cache
 def _curriculum(name: str):

@@ -8,6 +8,8 @@ import torch
 
 from .helpers import make_trainer, read_curve, smoke_cfg
 
+pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
+
 TRAINED = ("mean_reward", "mean_episode_length", "value_loss", "surrogate_loss", "action_std")
 
 

@@ -10,6 +10,8 @@ from lca.learn.exploration import noise_ceiling
 
 from .helpers import make_trainer, read_curve, smoke_cfg
 
+pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
+
 
 def test_ceiling_falls_linearly_to_the_final_std_and_holds():
     cfg = ActorConfig(init_noise_std=1.0, final_noise_std=0.4, noise_deadline=0.5)

@@ -29,6 +29,8 @@ from .helpers import (
     run_cli,
 )
 
+pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
+
 RUN_NAMES = ["actor=lstm,logger=none,scale=smoke", "actor=mlp,logger=none,scale=smoke"]
 
 

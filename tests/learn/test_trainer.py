@@ -18,6 +18,8 @@ from lca.store import RunDir
 
 from .helpers import WANDB_KEYS, make_trainer, read_curve, smoke_cfg
 
+pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
+
 # Stage of iterations 0 and 1 of a 2-iteration run (`two` switches at ceil(0.5 * 2) = 1).
 STAGES = {
     "blind": ["blind", "blind"],

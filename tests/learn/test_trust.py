@@ -18,6 +18,8 @@ from lca.store import RunDir, RunLockedError
 
 from .helpers import make_trainer, read_curve, smoke_cfg
 
+pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
+
 HOLD = (
     "import sys, time; from lca.store import RunDir\n"
     "with RunDir(sys.argv[1]).lock():\n"

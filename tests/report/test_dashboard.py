@@ -14,6 +14,8 @@ from .helpers import CHROMIUM_FLAGS as FLAGS
 from .helpers import chromium as _chromium
 from .helpers import fixture_spec
 
+pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
+
 POLICIES = ["Blind", "One-Stage MLP", "Two-Stage MLP"]
 
 

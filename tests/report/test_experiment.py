@@ -12,6 +12,8 @@ from lca.config import compose
 
 from .helpers import REPO, run_python
 
+pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
+
 PAPER_SIM = REPO / "experiments" / "paper_sim.yaml"
 POLICIES = ["blind", "one_mlp", "two_mlp", "one_lstm", "two_lstm", "one_cnn", "two_cnn"]
 SEEDS = [0, 1, 2]

@@ -17,6 +17,8 @@ from lca.report.build import build_report
 
 from .helpers import build_fixture_store, chromium_media
 
+pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
+
 BLIND = "aaa_policy=two_cnn"  # the Blind run of fixtures/runs.yaml
 ONE_MLP = "policy=two_mlp,seed=0"  # the One-Stage MLP run
 FPS = 25

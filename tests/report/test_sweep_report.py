@@ -13,6 +13,8 @@ from lca.evaluate.metrics import METRICS
 
 from .helpers import REPO, cell_units, run_python
 
+pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
+
 SWEEP = [
     "-m",
     "policy=one_mlp,two_mlp",
