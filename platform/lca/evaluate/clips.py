@@ -21,6 +21,7 @@ from omegaconf import DictConfig
 
 from lca.evaluate.policy import load_policy
 from lca.evaluate.protocol import cell_config, cell_name, round_seed
+from lca.evaluate.rollout import rollout, start
 from lca.evaluate.video import Telemetry, overlay, write_clip, write_png
 from lca.learn import curriculum
 from lca.sim import render
@@ -83,8 +84,7 @@ def record(
     then, so its last frame is held, captioned."""
     stride = frame_stride(env.dt)
     rec = Recording(fps=clip_fps(env.dt))
-    obs = env.reset_all()
-    policy.reset(torch.ones(env.num_envs, dtype=torch.bool, device=env.device))
+    steps_taken = rollout(env, policy, start(env, policy), steps=2**62)
     note, note_frames, steps = "", 0, 0
 
     def capture(text: str) -> None:
@@ -100,10 +100,8 @@ def record(
     while len(rec) < last_frame:
         ended = ""
         for _ in range(stride):
-            obs, _, dones, extras = env.step(policy(obs))
-            policy.reset(dones.bool())
+            _, m = next(steps_taken)
             steps += 1
-            m = extras["metrics"]
             if m["terminated"][0] or (goal is not None and m["time_out"][0]):
                 ended = "fell" if m["terminated"][0] else "time limit"
                 break

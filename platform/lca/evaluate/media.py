@@ -21,9 +21,9 @@ from omegaconf import DictConfig, OmegaConf
 from lca.evaluate.clips import cell_setting, gl_missing, save, shoot
 from lca.evaluate.policy import final_checkpoint
 from lca.evaluate.protocol import cell_config, cell_name
-from lca.learn.rundir import atomic_write
 from lca.sim.preview import write_preview
 from lca.sim.terrain import generate
+from lca.store import atomic_write
 
 CLIPS, TERRAINS = "clips", "terrain"
 VERSION = 1  # bump when the pictures change, so that older ones are made again
