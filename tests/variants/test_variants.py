@@ -7,6 +7,7 @@ import os
 import subprocess
 import sys
 
+import numpy as np
 import pandas as pd
 import pytest
 from _cli import REPO, SMOKE, cli_env
@@ -92,3 +93,43 @@ def test_a_term_declared_with_params_gets_them(example_variants) -> None:
     )
     total, _ = compute_rewards(ctx, weights, dt=1.0, params=params)
     assert total == pytest.approx([-8.0])  # |2|^3, not the default square
+
+
+class StepCounter:
+    """A stateful reward term: how many steps each env has lived (reset with the env)."""
+
+    def __init__(self) -> None:
+        self.count = None
+        self.resets: list[np.ndarray] = []
+
+    def __call__(self, c) -> np.ndarray:
+        if self.count is None:
+            self.count = np.zeros(len(c.command))
+        self.count += 1
+        return self.count.copy()
+
+    def reset(self, env_ids: np.ndarray) -> None:
+        self.resets.append(np.asarray(env_ids).copy())
+        if self.count is not None:
+            self.count[env_ids] = 0
+
+
+def test_a_stateful_term_is_reset_with_its_envs() -> None:
+    import torch
+
+    from lca.config.registry import REWARD_TERMS
+    from lca.task.env import LocomotionEnv
+
+    term = StepCounter()
+    REWARD_TERMS.register("steps_alive")(term)
+    try:
+        env = LocomotionEnv(compose(["scale=smoke", "terrain=flat", "+task.rewards.steps_alive=0"]))
+        env.reset_all()
+        for _ in range(3):
+            env.step(torch.zeros(env.num_envs, env.num_actions))
+        assert term.count.tolist() == [3.0] * env.num_envs
+        env._reset_envs(np.array([1, 4]))
+        assert term.resets[-1].tolist() == [1, 4]
+        assert term.count[[0, 1, 4]].tolist() == [3.0, 0.0, 0.0]
+    finally:
+        REWARD_TERMS.unregister("steps_alive")

@@ -16,6 +16,7 @@ from omegaconf import DictConfig, OmegaConf
 from rsl_rl.env import VecEnv
 from tensordict import TensorDict
 
+from lca.config.registry import REWARD_TERMS
 from lca.config.runtime import resolve_device
 from lca.sim.batch import BatchedSim
 from lca.sim.depth_camera import CameraSpec, DepthCameras
@@ -32,6 +33,7 @@ from lca.task.state import (
     yaw_of,
     zero_rows,
 )
+from lca.task.step_metrics import step_metrics
 from lca.task.terminations import fell, non_finite
 
 BAD_STATE_WARNINGS = [
@@ -82,6 +84,8 @@ class LocomotionEnv(VecEnv):
         mid, half = (lower + upper) / 2, (upper - lower) / 2 * task.reward_params.soft_limit_factor
         self.joint_lower, self.joint_upper = mid - half, mid + half
         self.weights, self.reward_term_params = weights_and_params(task.rewards)
+        terms = [REWARD_TERMS[name] for name in self.weights]
+        self._stateful_terms = [t.reset for t in terms if callable(getattr(t, "reset", None))]
         # the reward curriculum's knobs (lca.learn.reward_curriculum); the paper's: 1, False
         self.penalty_scale = 1.0
         self.only_positive = bool(task.only_positive_rewards)
@@ -175,10 +179,11 @@ class LocomotionEnv(VecEnv):
             self.episode_sums[name] += value
 
         done = terminated | time_out
+        strike = self.task_cfg.reward_params.strike_threshold
         extras = {
             "time_outs": torch.as_tensor(time_out, device=self.device),
             "log": {},
-            "metrics": self._step_metrics(state, terminated, time_out),
+            "metrics": step_metrics(state, self.commands.value, terminated, time_out, strike),
         }
         done_ids = np.flatnonzero(done)
         if done_ids.size:
@@ -224,6 +229,8 @@ class LocomotionEnv(VecEnv):
         self.last_action[ids] = 0.0
         for sums in self.episode_sums.values():
             sums[ids] = 0.0
+        for reset in self._stateful_terms:  # reward terms that keep per-env state
+            reset(ids)
 
     def _maybe_push(self) -> None:
         if self._push_steps <= 0:
@@ -312,19 +319,6 @@ class LocomotionEnv(VecEnv):
             batch_size=[n],
             device=self.device,
         )
-
-    def _step_metrics(self, state: RobotState, terminated: np.ndarray, time_out: np.ndarray):
-        """Per-env numpy quantities of this step, before any reset, for evaluation."""
-        threshold = self.task_cfg.reward_params.strike_threshold
-        error = self.commands.value[:, :2] - state.base_lin_vel[:, :2]
-        return {
-            "terminated": terminated.copy(),
-            "time_out": time_out.copy(),
-            "lateral_impact": (state.foot_lateral_force > threshold).any(axis=1),
-            "track_error": np.linalg.norm(error, axis=1),
-            "command_speed": np.linalg.norm(self.commands.value[:, :2], axis=1),
-            "base_pos": state.base_pos.copy(),
-        }
 
     def _camera_map(self, state: RobotState, yaw: np.ndarray) -> np.ndarray:
         """The latest deployment map: cameras fire at `rate_hz`; between frames the policy

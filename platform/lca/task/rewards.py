@@ -165,7 +165,9 @@ def termination_penalty(c: RewardContext) -> np.ndarray:
 
 
 # The table's terms, registered by name (lca.config.registry); a plugin adds its own the
-# same way, REWARD_TERMS.register("name")(f), then gives it a weight under task.rewards.
+# same way, REWARD_TERMS.register("name")(f), then gives it a weight under task.rewards. A
+# term that keeps per-env state is an object with __call__(ctx, **params) and reset(env_ids),
+# which the env calls for the envs it resets.
 for _term in (
     track_lin_vel_xy_exp,
     track_ang_vel_z_exp,
