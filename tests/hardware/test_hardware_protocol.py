@@ -163,9 +163,11 @@ def test_hardware_cli_writes_two_trials_per_task(hardware_csv: pd.DataFrame):
     assert t.task.tolist() == ["stair_ascent"] * 2 + ["soft_ledge"] * 2
     assert t.trial.tolist() == [0, 1, 0, 1]
     assert t.success.dtype == bool
-    ok = t.success.to_numpy()
-    assert t.drift_m[~ok].isna().all() and t.time_s[~ok].isna().all()
-    assert np.isfinite(t.drift_m[ok]).all() and (t.time_s[ok] <= 1.0).all()
+    # the goal is >= 1.7 m away and the limit 1 s at 0.3 m/s: no trial can succeed here, so
+    # every outcome is a failure without drift or time (scoring of successes: see
+    # test_trial_scoring.py, with scripted bases)
+    assert not t.success.any()
+    assert t.drift_m.isna().all() and t.time_s.isna().all()
 
 
 def test_hardware_cli_rejects_a_missing_run_dir(capsys):

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import copy
 import time
+from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
@@ -43,19 +44,28 @@ def task_config(cfg: DictConfig) -> DictConfig:
 
 @torch.inference_mode()
 def run_trials(env: LocomotionEnv, policy, task: HardwareTask, steps: int) -> pd.DataFrame:
-    n = env.num_envs
     obs = start(env, policy)
     start_y = env.sim.qpos[:, 1].copy()
+    return score_trials(rollout(env, policy, obs, steps), start_y, task.goal_x, env.dt)
+
+
+def score_trials(
+    steps: Iterable[tuple[int, dict]], start_y: np.ndarray, goal_x: float, dt: float
+) -> pd.DataFrame:
+    """Each trial's outcome from its per-step metrics: a success when the base first crosses
+    `goal_x` without having fallen or timed out; the signed lateral drift from `start_y` and
+    the time at that step."""
+    n = len(start_y)
     active = np.ones(n, dtype=bool)
     success = np.zeros(n, dtype=bool)
     drift = np.full(n, np.nan)
     time_s = np.full(n, np.nan)
-    for step, m in rollout(env, policy, obs, steps):
-        done_now = active & (m["base_pos"][:, 0] >= task.goal_x) & ~m["terminated"]
+    for step, m in steps:
+        done_now = active & (m["base_pos"][:, 0] >= goal_x) & ~m["terminated"]
         success |= done_now
         # the net lateral drift, signed: the table's precision removes a fixed bias
         drift = np.where(done_now, m["base_pos"][:, 1] - start_y, drift)
-        time_s = np.where(done_now, (step + 1) * env.dt, time_s)
+        time_s = np.where(done_now, (step + 1) * dt, time_s)
         active &= ~(done_now | m["terminated"] | m["time_out"])
         if not active.any():
             break
