@@ -48,3 +48,21 @@ def test_the_check_sees_a_violation(tmp_path) -> None:
     bad = tmp_path / "bad.py"
     bad.write_text("def f():\n    from lca.task.rewards import REWARD_TERMS\n")
     assert stage_of(next(iter(lca_imports(bad)))) == "task"
+
+
+def test_a_fresh_process_knows_every_built_in_variant() -> None:
+    """Composition alone (no stage imported first) loads every registry's built-ins."""
+    import json
+    import subprocess
+    import sys
+
+    code = (
+        "from lca.config import compose\n"
+        "from lca.config import registry as r\n"
+        "compose(['scale=smoke'])\n"
+        "print([len(x.names()) for x in (r.TILES, r.OBS_TERMS, r.REWARD_TERMS, r.ACTORS,"
+        " r.ENCODERS, r.EVAL_TERRAINS)])\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    counts = json.loads(out.stdout.strip())
+    assert all(n > 0 for n in counts), counts
