@@ -13,7 +13,7 @@ import lca
 
 PACKAGE = Path(lca.__file__).resolve().parent
 ORDER = ["config", "sim", "task", "learn", "evaluate", "report"]
-BASE = {"lca", "lca.paths", "lca.cli", "lca.store"}  # what every stage may use
+BASE = {"lca", "lca.paths", "lca.cli", "lca.store", "lca.testhook"}  # what every stage may use
 
 
 def lca_imports(path: Path) -> set[str]:

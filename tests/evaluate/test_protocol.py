@@ -4,11 +4,8 @@ accounting, the results files, and resuming an interrupted evaluation without do
 
 from __future__ import annotations
 
-import os
 import shutil
-import signal
 import subprocess
-import time
 from pathlib import Path
 
 import numpy as np
@@ -30,6 +27,7 @@ from lca.evaluate.protocol import (
 from lca.evaluate.run import evaluate_and_write
 from lca.sim.terrain import generate
 from lca.task.env import LocomotionEnv
+from lca.testhook import KILLED
 
 from .helpers import (
     CONF,
@@ -292,7 +290,7 @@ def test_resume_after_a_lost_round(evaluated_run, tmp_path) -> None:
 
 
 def test_resume_after_a_killed_evaluation(evaluated_run, tmp_path) -> None:
-    """SIGKILL `python -m lca.evaluate` after its first round, evaluate again: the finished
+    """Kill `python -m lca.evaluate` after its first round, evaluate again: the finished
     rounds are kept, the rest are run once, and the results equal an uninterrupted evaluation."""
     cfg, run_dir, _ = evaluated_run
     copy = _copy_run(run_dir, tmp_path)
@@ -301,27 +299,19 @@ def test_resume_after_a_killed_evaluation(evaluated_run, tmp_path) -> None:
     shutil.rmtree(copy / "eval")
     files = episode_files(copy, cfg)
 
-    proc = subprocess.Popen(
+    # the test hook ends the evaluation like a SIGKILL right after its first round's file
+    killed = subprocess.run(
         evaluate_command(copy),
         cwd=tmp_path,
-        env=cli_env(),
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-        start_new_session=True,
+        env=cli_env() | {"LCA_TEST_EXIT_AFTER": "round:1"},
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
     )
-    try:
-        deadline = time.monotonic() + 90
-        while not files[0].exists() and proc.poll() is None and time.monotonic() < deadline:
-            time.sleep(0.01)
-        if proc.poll() is None:
-            os.killpg(proc.pid, signal.SIGKILL)  # the process group of the evaluation we started
-    finally:
-        if proc.poll() is None:
-            os.killpg(proc.pid, signal.SIGKILL)
-        proc.wait(timeout=30)
-    assert proc.returncode == -signal.SIGKILL, "the evaluation ended before it was killed"
+    assert killed.returncode == KILLED, killed.stdout[-2000:] + killed.stderr[-2000:]
     done = [p for p in files if p.exists()]
-    assert 1 <= len(done) < len(files), "killed too late to interrupt anything"
+    assert done == files[:1], "exactly the first round is on disk"
     assert not (copy / "results.parquet").exists()
     mtimes = {p: p.stat().st_mtime_ns for p in done}
 

@@ -4,11 +4,8 @@ completed runs, resuming a killed run, a bad override, and what a run records ab
 from __future__ import annotations
 
 import json
-import os
 import re
-import signal
 import subprocess
-import time
 from importlib import metadata
 from pathlib import Path
 
@@ -18,6 +15,7 @@ from omegaconf import OmegaConf
 
 from lca.config import compose
 from lca.store import PACKAGES
+from lca.testhook import KILLED
 
 from .helpers import (
     REPO,
@@ -140,39 +138,30 @@ RESUME_RUN = "logger=none,scale.checkpoint_interval=2,scale.max_iterations=6,sca
 
 
 def test_killed_run_resumes(tmp_path) -> None:
-    """SIGKILL a 6-iteration run once its first `latest.pt` (iteration 1) exists and the curve
+    """Kill a 6-iteration run once its first `latest.pt` (iteration 1) exists and the curve
     has a row past it; re-running the same command resumes from the checkpoint, redoes only
     the lost iterations and completes with each iteration once in train_curve.csv."""
     runs_root = tmp_path / "runs"
     args = [*RESUME_ARGS, f"runs_root={runs_root}"]
     run = runs_root / RESUME_RUN
     latest, curve = run / "checkpoints" / "latest.pt", run / "train_curve.csv"
-    proc = subprocess.Popen(
+    # the test hook ends the run like a SIGKILL right after iteration 2: the checkpoint is
+    # iteration 1's (every 2 iterations) and the curve holds a row past it
+    killed = subprocess.run(
         cli_command(*args),
         cwd=tmp_path,
-        env=cli_env(),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
+        env=cli_env() | {"LCA_TEST_EXIT_AFTER": "iteration:2"},
+        capture_output=True,
         text=True,
+        timeout=300,
+        check=False,
     )
-    ready = False
-    try:
-        deadline = time.monotonic() + 120
-        while not ready and time.monotonic() < deadline and proc.poll() is None:
-            # header + iterations 0, 1, 2 in the curve, and a checkpoint
-            ready = latest.exists() and curve.exists() and len(curve.read_text().splitlines()) >= 4
-            time.sleep(0 if ready else 0.005)
-        assert proc.poll() is None, "run ended before it could be killed:\n" + proc.stdout.read()
-        os.kill(proc.pid, signal.SIGKILL)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-        first_out = proc.communicate()[0]
-    assert ready, "no checkpoint within 120 s:\n" + first_out
-    assert proc.returncode == -signal.SIGKILL
+    first_out = killed.stdout + killed.stderr
+    assert killed.returncode == KILLED, first_out[-3000:]
     assert not (run / "COMPLETE").exists(), first_out
     ckpt_iter = torch.load(latest, weights_only=False, map_location="cpu")["iter"]
-    assert ckpt_iter in (1, 3)
+    assert ckpt_iter == 1
+    assert len(read_curve(curve)) == 3  # iterations 0, 1, 2
     rows_before = read_curve(curve)
     kept = [r for r in rows_before if int(r["iteration"]) <= ckpt_iter]
 

@@ -28,6 +28,7 @@ from lca.evaluate.terrains import eval_mixture
 from lca.learn import curriculum
 from lca.store import atomic_write
 from lca.task.env import LocomotionEnv
+from lca.testhook import exit_point
 
 
 def cell_name(cell) -> str:
@@ -104,6 +105,7 @@ def evaluate_run(run_dir: Path, cfg: DictConfig, log=print) -> pd.DataFrame:
     perception = curriculum.perception_on(cfg.curriculum, total - 1, total)
     out_dir = run_dir / "eval"
     _discard_stale_rounds(out_dir, ev, log)
+    written = 0
     for cell in ev.cells:
         name = cell_name(cell)
         todo = [e for e in range(ev.episodes) if not (out_dir / name / f"episode_{e}.csv").exists()]
@@ -120,6 +122,8 @@ def evaluate_run(run_dir: Path, cfg: DictConfig, log=print) -> pd.DataFrame:
             frame.insert(0, "unit", np.arange(ev.units))
             frame.insert(1, "episode", episode)
             atomic_write(out_dir / name / f"episode_{episode}.csv", frame.to_csv(index=False))
+            written += 1
+            exit_point("round", written)
             if log:
                 rate = ev.units * ev.steps / (time.perf_counter() - t0)
                 log(

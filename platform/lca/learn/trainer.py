@@ -34,6 +34,7 @@ from lca.learn.variants import actor_spec
 from lca.store import RunDir
 from lca.task.env import LocomotionEnv
 from lca.task.env_state import env_state, restore_env_state
+from lca.testhook import exit_point
 
 LATEST, PREVIOUS = "latest.pt", "previous.pt"
 LOOP_STATE = "lca_loop_state"  # env, episode statistics, RNG and recurrent states
@@ -378,6 +379,7 @@ class Trainer:
                 )
             if (it + 1) % cfg.scale.checkpoint_interval == 0:
                 self.save(LATEST, it)
+            exit_point("iteration", it)
             if hook is not None:
                 t_hook = time.perf_counter()
                 stop = hook(self, it, row)
