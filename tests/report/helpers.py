@@ -135,8 +135,13 @@ def cell_units(frame: pd.DataFrame, terrain: str, difficulty: str, metric: str) 
     return cell.groupby("unit")[metric].mean()
 
 
+CI_COLUMNS = ("ci_low", "ci_high")  # checked against an independent bootstrap instead
+
+
 def check_golden(produced: Path, name: str) -> None:
-    """`produced` must equal golden/<name> byte for byte (LCA_UPDATE_GOLDEN=1 rewrites it)."""
+    """`produced` must equal golden/<name> (LCA_UPDATE_GOLDEN=1 rewrites it): a CSV cell by
+    cell, numbers to a relative 1e-9 (a library's float rounding is not a regression) and
+    without the bootstrap CI columns; any other file byte for byte."""
     golden = GOLDEN / name
     # under CI a rewrite would compare the output with itself
     assert not (UPDATE_GOLDEN and os.environ.get("CI")), "LCA_UPDATE_GOLDEN is set under CI"
@@ -144,7 +149,31 @@ def check_golden(produced: Path, name: str) -> None:
         golden.parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(produced, golden)
     assert golden.is_file(), f"missing {golden}; generate it with LCA_UPDATE_GOLDEN=1"
-    assert produced.read_text() == golden.read_text(), f"{produced} differs from {golden}"
+    if produced.suffix != ".csv":
+        assert produced.read_text() == golden.read_text(), f"{produced} differs from {golden}"
+        return
+    got, want = pd.read_csv(produced), pd.read_csv(golden)
+    assert list(got.columns) == list(want.columns), f"{name}: columns differ"
+    assert len(got) == len(want), f"{name}: {len(got)} rows, golden {len(want)}"
+    for column in got.columns:
+        if column in CI_COLUMNS:
+            continue
+        a, b = got[column], want[column]
+        if pd.api.types.is_numeric_dtype(a) and pd.api.types.is_numeric_dtype(b):
+            close = np.isclose(a, b, rtol=1e-9, atol=1e-12, equal_nan=True)
+            assert close.all(), f"{name}.{column} rows {np.flatnonzero(~close).tolist()} differ"
+        else:
+            assert a.astype(str).tolist() == b.astype(str).tolist(), f"{name}.{column} differs"
+
+
+def percentile_bootstrap(values: np.ndarray, confidence: float, resamples: int, seed: int):
+    """The percentile bootstrap CI of the mean, written out: resample units with replacement,
+    take the mean of each resample, read the two tail quantiles."""
+    rng = np.random.default_rng(seed)
+    picks = rng.integers(0, len(values), size=(resamples, len(values)))
+    means = np.asarray(values, float)[picks].mean(axis=1)
+    tail = (1 - confidence) / 2 * 100
+    return np.percentile(means, tail), np.percentile(means, 100 - tail)
 
 
 CHROMIUM = "/usr/bin/chromium"

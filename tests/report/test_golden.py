@@ -20,7 +20,15 @@ from lca.report.build import build_report
 from lca.report.collect import find_run_dirs, load_run
 from lca.report.figures import SMOOTH, reward_curves
 
-from .helpers import NOT_A_RUN, cell_units, check_golden, fixture_cells, fixture_spec, train_curve
+from .helpers import (
+    NOT_A_RUN,
+    cell_units,
+    check_golden,
+    fixture_cells,
+    fixture_spec,
+    percentile_bootstrap,
+    train_curve,
+)
 
 LABELS = {
     "blind": "Blind",
@@ -40,6 +48,34 @@ BOLD = r"\textbf{"
 @pytest.mark.parametrize("name", ["sim_table.csv", "sim_table.tex", "claim.csv"])
 def test_matches_golden(fixture_report: Path, name: str) -> None:
     check_golden(fixture_report / name, name)
+
+
+def test_table_cis_match_an_independent_bootstrap(fixture_store: Path, fixture_report: Path):
+    """Each row's CI against a percentile bootstrap written in the test, over unit values
+    worked out from the raw episodes (seeds pooled): endpoints agree within a tenth of the
+    units' range, and the CI holds the mean."""
+    units: dict[tuple, dict[str, float]] = {}
+    for run in fixture_spec()["runs"]:
+        path = fixture_store / run["folder"] / "results.parquet"
+        if not path.exists():
+            continue
+        episodes = pd.read_parquet(path)
+        for (terrain, difficulty), cell in episodes.groupby(["cell_terrain", "cell_difficulty"]):
+            for metric in ("success", "contacts_per_step", "track_cm_s"):
+                per_unit = cell.groupby("unit")[metric].mean()
+                key = (LABELS[run["policy"]], terrain, difficulty, metric)
+                for unit, value in per_unit.items():
+                    units.setdefault(key, {})[f"{run['seed']}:{unit}"] = value
+    table = pd.read_csv(fixture_report / "sim_table.csv")
+    assert len(table) == len(units)
+    for row in table.itertuples():
+        values = np.array(
+            list(units[(row.policy, row.terrain, row.difficulty, row.metric)].values())
+        )
+        low, high = percentile_bootstrap(values, 0.95, 20000, seed=1)
+        slack = 0.1 * (values.max() - values.min()) + 1e-9
+        assert abs(row.ci_low - low) <= slack and abs(row.ci_high - high) <= slack, row
+        assert row.ci_low - 1e-9 <= row.mean <= row.ci_high + 1e-9
 
 
 def test_report_files(fixture_report: Path) -> None:
