@@ -22,12 +22,15 @@ def cli_env() -> dict[str, str]:
     return env
 
 
-def run_python(*args: str, cwd: Path, timeout: float = 120) -> subprocess.CompletedProcess:
-    """`python ARGS` from `cwd`, output captured (MuJoCo may drop a MUJOCO_LOG.TXT there)."""
+def run_python(
+    *args: str, cwd: Path, timeout: float = 120, env: dict[str, str] | None = None
+) -> subprocess.CompletedProcess:
+    """`python ARGS` from `cwd`, output captured (MuJoCo may drop a MUJOCO_LOG.TXT there), in
+    `env` (default: `cli_env()`)."""
     return subprocess.run(
         [sys.executable, *args],
         cwd=cwd,
-        env=cli_env(),
+        env=cli_env() if env is None else env,
         capture_output=True,
         text=True,
         timeout=timeout,
@@ -35,11 +38,15 @@ def run_python(*args: str, cwd: Path, timeout: float = 120) -> subprocess.Comple
     )
 
 
-def run_module(*args: str, cwd: Path, timeout: float = 120) -> subprocess.CompletedProcess:
+def run_module(
+    *args: str, cwd: Path, timeout: float = 120, env: dict[str, str] | None = None
+) -> subprocess.CompletedProcess:
     """`python -m ARGS` from `cwd`."""
-    return run_python("-m", *args, cwd=cwd, timeout=timeout)
+    return run_python("-m", *args, cwd=cwd, timeout=timeout, env=env)
 
 
-def run_cli(*args: str, cwd: Path, timeout: float = 120) -> subprocess.CompletedProcess:
+def run_cli(
+    *args: str, cwd: Path, timeout: float = 120, env: dict[str, str] | None = None
+) -> subprocess.CompletedProcess:
     """`python run.py ARGS` from `cwd`."""
-    return run_python(str(RUN_PY), *args, cwd=cwd, timeout=timeout)
+    return run_python(str(RUN_PY), *args, cwd=cwd, timeout=timeout, env=env)

@@ -23,7 +23,7 @@ from lca.evaluate.policy import load_run_config
 from lca.evaluate.run import evaluate_and_write
 from lca.sim.render import HEIGHT, WIDTH, gl_unavailable
 
-from .helpers import REPO, cli_env, train_tiny_run
+from .helpers import REPO, cli_env, run_module, train_tiny_run
 
 pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
 
@@ -106,15 +106,7 @@ def test_evaluation_without_gl_skips_clips(filmed_run, tmp_path: Path) -> None:
     run = tmp_path / "run"
     shutil.copytree(filmed_run[0], run, ignore=shutil.ignore_patterns("clips", "terrain"))
     env = cli_env() | {"MUJOCO_GL": "disable"}
-    out = subprocess.run(
-        [sys.executable, "-m", "lca.evaluate", f"run_dir={run}"],
-        cwd=tmp_path,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=300,
-        check=False,
-    )
+    out = run_module("lca.evaluate", f"run_dir={run}", cwd=tmp_path, timeout=300, env=env)
     assert out.returncode == 0, out.stderr[-3000:]
     skipped = [line for line in out.stdout.splitlines() if "clips skipped" in line]
     assert len(skipped) == 1 and "MUJOCO_GL=disable" in skipped[0], out.stdout[-2000:]
@@ -141,15 +133,7 @@ def test_hardware_clip(filmed_run, tmp_path: Path) -> None:
 
 
 def play(*args: str, cwd: Path, env: dict | None = None) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "lca.play", *args],
-        cwd=cwd,
-        env=env or cli_env(),
-        capture_output=True,
-        text=True,
-        timeout=300,
-        check=False,
-    )
+    return run_module("lca.play", *args, cwd=cwd, timeout=300, env=env)
 
 
 @pytest.fixture(scope="module")

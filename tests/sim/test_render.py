@@ -5,15 +5,13 @@ MuJoCo cannot render."""
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import matplotlib.image
 import mujoco
 import numpy as np
 import pytest
+from _cli import run_module
 
 from lca.sim import render
 
@@ -118,17 +116,8 @@ def test_g1_standing_on_flat_ground_is_in_the_frame(flat_cfg, flat_scene) -> Non
 def test_scene_preview_cli(tmp_path: Path) -> None:
     """`python -m lca.scene terrain=stairs_up difficulty=hard scale=smoke preview=...`."""
     png = tmp_path / "terrain.png"
-    env = {k: v for k, v in os.environ.items() if not k.startswith("HYDRA_")}
     args = ["terrain=stairs_up", "difficulty=hard", "scale=smoke", f"preview={png}"]
-    out = subprocess.run(
-        [sys.executable, "-m", "lca.scene", *args],
-        cwd=tmp_path,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=180,
-        check=False,
-    )
+    out = run_module("lca.scene", *args, cwd=tmp_path, timeout=180)
     assert out.returncode == 0, out.stderr[-3000:]
     assert f"wrote {png}" in out.stdout
     image = matplotlib.image.imread(png)
@@ -137,13 +126,5 @@ def test_scene_preview_cli(tmp_path: Path) -> None:
     assert left.std() > 0.1  # the height map
     if render.gl_unavailable() is None:
         assert right.std() > 0.05  # the rendered close-up
-    usage = subprocess.run(
-        [sys.executable, "-m", "lca.scene", "scale=smoke"],
-        cwd=tmp_path,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=120,
-        check=False,
-    )
+    usage = run_module("lca.scene", "scale=smoke", cwd=tmp_path)
     assert usage.returncode == 2 and "preview=PATH.png" in usage.stderr

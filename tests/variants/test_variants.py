@@ -4,13 +4,11 @@ whole pipeline and get rows and columns of their own in the report."""
 from __future__ import annotations
 
 import os
-import subprocess
-import sys
 
 import numpy as np
 import pandas as pd
 import pytest
-from _cli import REPO, SMOKE, cli_env
+from _cli import SMOKE, cli_env, run_cli
 
 from lca.config import ConfigError, compose
 from lca.learn.train_cfg import build_train_cfg
@@ -58,15 +56,7 @@ def test_variants_from_outside_run_train_evaluate_report(tmp_path) -> None:
         "hydra.run.dir=" + str(run),
     ]
     args += ["+task.rewards.base_yaw_rate_l2={weight: -0.1, params: {power: 2.0}}"]
-    done = subprocess.run(
-        [sys.executable, str(REPO / "run.py"), *args],
-        cwd=tmp_path,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=300,
-        check=False,
-    )
+    done = run_cli(*args, cwd=tmp_path, timeout=300, env=env)
     assert done.returncode == 0, done.stderr[-3000:]
     assert "declares no export" in done.stdout
     assert not (run / "exported" / "policy.onnx").exists()

@@ -1,0 +1,40 @@
+"""The launcher presets compose with the project's config, and each job config says what the
+preset promises (a joblib pool of 2 here; one SLURM job per run that is requeued)."""
+
+from __future__ import annotations
+
+import importlib.util
+
+import pytest
+from hydra import compose, initialize_config_dir
+
+from lca.config import schema
+from lca.paths import conf_dir
+
+
+def launcher(name: str):
+    schema.register()
+    with initialize_config_dir(config_dir=str(conf_dir()), version_base="1.3"):
+        cfg = compose("config", [f"hydra/launcher={name}"], return_hydra_config=True)
+    return cfg.hydra.launcher, cfg
+
+
+def test_local_is_a_joblib_pool_of_two() -> None:
+    job, _ = launcher("local")
+    assert job._target_.endswith("JoblibLauncher")
+    assert job.n_jobs == 2
+
+
+def test_slurm_requeues_one_job_per_run() -> None:
+    job, cfg = launcher("slurm")
+    assert job._target_.endswith("submitit_launcher.SlurmLauncher")
+    assert (job.nodes, job.tasks_per_node, job.gpus_per_node) == (1, 1, 1)
+    assert job.timeout_min == 720 and job.max_num_timeout == 3
+    assert job.submitit_folder == f"{cfg.hydra.sweep.dir}/.submitit/%j"
+
+
+def test_ray_places_runs_on_a_cluster() -> None:
+    if importlib.util.find_spec("hydra_plugins.hydra_ray_launcher") is None:
+        pytest.skip('hydra-ray-launcher is not installed (pip install -e ".[ray]")')
+    job, _ = launcher("ray")
+    assert job.ray.init.address == "auto" and job.ray.remote.num_cpus == 4
