@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import re
 from itertools import product
 
@@ -82,3 +83,23 @@ def test_dry_run_documented_argument_order() -> None:
     out = run_python("-m", "lca.experiment", str(PAPER_SIM), "--dry-run", "scale=smoke", cwd=REPO)
     assert out.returncode == 0, out.stderr
     assert _per_run_steps(out.stdout) == _expected_steps("scale=smoke")
+
+
+def test_dry_run_hours_from_the_measured_rates(paper_plan: str) -> None:
+    """Worked by hand: 40 000 iterations x 24 steps x 4096 envs of training and 4 cells x 500
+    units x 3 episodes x 1000 steps of evaluation, at the rates the benchmarks stored."""
+    bench = REPO / "reports" / "bench"
+    train_rate = json.loads((bench / "train.json").read_text())["steps_per_s"]
+    eval_rate = max(
+        r["steps_per_s"] for r in json.loads((bench / "env.json").read_text())["batched"]
+    )
+    hours = (3_932_160_000 / train_rate + 6_000_000 / eval_rate) / 3600
+    assert f"estimated cost: {hours:.2f} h per run, {21 * hours:.1f} core-pair hours" in paper_plan
+
+
+def test_hardware_experiment_plan() -> None:
+    out = _dry_run(str(REPO / "experiments" / "paper_hardware.yaml"), "--dry-run")
+    planned = re.findall(r"^  policy=(\w+) seed=(\d+)", out, flags=re.M)
+    assert planned == [("blind", "0"), ("one_mlp", "0"), ("two_cnn", "0"), ("two_mlp", "0")]
+    assert "4 runs into runs/paper_sim/" in out  # shares the simulation table's trained runs
+    assert "then: `python -m lca.hardware` on each run" in out
