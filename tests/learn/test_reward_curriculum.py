@@ -122,3 +122,31 @@ def test_tracking_gate_steps_up_only_while_the_robot_tracks():
     assert c.scale == pytest.approx(1.0)
     late = RewardCurriculum(cfg, total_iterations=20)
     assert late.update(18, 0.0, 0.0) == 1.0  # the deadline, whatever the robot does
+
+
+def test_boosts_fall_linearly_to_none_at_the_paper_weights():
+    cfg = RewardCurriculumConfig(
+        enabled=True, by="iterations", penalty_start=0.2, deadline=1.0, boost={"phase_contact": 4.0}
+    )
+    c = RewardCurriculum(cfg, total_iterations=100)
+    c.update(0, 0.0)
+    assert c.boosts == {"phase_contact": 4.0}
+    c.update(50, 0.0)  # half way up the ramp: half the extra weight left
+    assert c.scale == pytest.approx(0.6)
+    assert c.boosts["phase_contact"] == pytest.approx(2.5)
+    c.update(100, 0.0)
+    assert c.done and c.boosts == {}  # the table's weights exactly
+    assert c.shaping == (1.0, False, {})
+
+
+def test_a_boost_multiplies_its_term_only():
+    from types import SimpleNamespace
+
+    from lca.task.rewards import compute_rewards
+
+    ctx = SimpleNamespace(terminated=np.array([False, True]), command=np.zeros((2, 3)))
+    weights = {"alive": 0.15, "termination_penalty": -200.0}
+    plain, _ = compute_rewards(ctx, weights, dt=1.0)
+    boosted, terms = compute_rewards(ctx, weights, dt=1.0, boosts={"alive": 3.0})
+    np.testing.assert_allclose(terms["alive"], [0.45, 0.0])
+    np.testing.assert_allclose(boosted - plain, [0.30, 0.0])

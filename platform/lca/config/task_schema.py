@@ -127,6 +127,9 @@ class RewardCurriculumConfig:
     hold_until: float = 0.5
     # terms scaled (their negative contributions); empty: every term, termination included
     terms: list[str] = field(default_factory=list)
+    # term -> factor on its weight at the start, falling linearly to 1 as the penalties reach
+    # the table's (e.g. {phase_contact: 4}: step with the gait clock before anything else)
+    boost: dict[str, float] = field(default_factory=dict)
 
     def check(self) -> None:
         key = "task.reward_curriculum"
@@ -148,6 +151,9 @@ class RewardCurriculumConfig:
         require(self.by in allowed, f"{key}.by", f"unknown '{self.by}'; allowed: {allowed}")
         for name in self.terms:
             REWARD_TERMS.check(name, f"{key}.terms")
+        for name, factor in self.boost.items():
+            REWARD_TERMS.check(name, f"{key}.boost.{name}")
+            require(factor > 0, f"{key}.boost.{name}", f"must be > 0, got {factor}")
 
 
 @dataclass

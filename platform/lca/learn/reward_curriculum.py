@@ -79,3 +79,17 @@ class RewardCurriculum:
     def done(self) -> bool:
         """True once the objective is the paper's: full penalties, no clipping."""
         return self.scale >= 1.0 and not self.only_positive
+
+    @property
+    def boosts(self) -> dict[str, float]:
+        """Factors on the boosted terms' weights: the configured ones at the start, 1 (none
+        left) once the penalties are the table's."""
+        if not self.cfg.enabled or self.done:
+            return {}
+        left = 1.0 - self.progress
+        return {k: 1.0 + (float(f) - 1.0) * left for k, f in self.cfg.boost.items()}
+
+    @property
+    def shaping(self) -> tuple[float, bool, dict[str, float]]:
+        """What the env applies: (penalty scale, clipping, boosts)."""
+        return self.scale, self.only_positive, self.boosts

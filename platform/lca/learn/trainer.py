@@ -284,7 +284,7 @@ class Trainer:
             length = self.last.get("mean_episode_length", math.nan)
             progress = self.last.get("tracking_progress", math.nan)
             self.rewards.update(it, float(length) / env.max_episode_length, float(progress))
-            env.set_reward_shaping(self.rewards.scale, self.rewards.only_positive)
+            env.set_reward_shaping(*self.rewards.shaping)
             env.commands.min_speed = self.commands.floor(it)
             ceiling = noise_ceiling(cfg.actor, it, self.total, self.rewards.progress)
             apply_ceiling(actor, ceiling)

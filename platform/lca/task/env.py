@@ -87,7 +87,7 @@ class LocomotionEnv(VecEnv):
         terms = [REWARD_TERMS[name] for name in self.weights]
         self._stateful_terms = [t.reset for t in terms if callable(getattr(t, "reset", None))]
         # the reward curriculum's knobs (lca.learn.reward_curriculum); the paper's: 1, False
-        self.penalty_scale = 1.0
+        self.penalty_scale, self.boosts = 1.0, {}
         self.only_positive = bool(task.only_positive_rewards)
         self.scaled_terms = frozenset(task.reward_curriculum.terms) or None
         self.perception = bool(task.perception)
@@ -174,6 +174,7 @@ class LocomotionEnv(VecEnv):
             self.penalty_scale,
             self.scaled_terms,
             self.reward_term_params,
+            self.boosts,
         )
         for name, value in terms.items():
             self.episode_sums[name] += value
@@ -365,9 +366,12 @@ class LocomotionEnv(VecEnv):
         self._obs = self._observe(read_state(self.sim, self.contacts))
         return self._obs
 
-    def set_reward_shaping(self, penalty_scale: float, only_positive: bool) -> None:
-        """Reward curriculum: negative contributions x `penalty_scale`; optional clipping."""
+    def set_reward_shaping(
+        self, penalty_scale: float, only_positive: bool, boosts: dict | None = None
+    ) -> None:
+        """Reward curriculum: penalties x `penalty_scale`, boosted weights, clipping."""
         self.penalty_scale = float(penalty_scale)
+        self.boosts = dict(boosts or {})
         self.only_positive = bool(only_positive) or bool(self.task_cfg.only_positive_rewards)
 
     def set_perception(self, on: bool) -> None:

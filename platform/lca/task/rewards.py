@@ -217,19 +217,23 @@ def compute_rewards(
     penalty_scale: float = 1.0,
     scaled_terms: frozenset[str] | None = None,
     params: dict[str, dict] | None = None,
+    boosts: dict[str, float] | None = None,
 ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Total reward and each weighted term, (N,). Terms are per second of simulated time,
     scaled by the policy step `dt`, so weights do not depend on the control rate.
 
     `penalty_scale` multiplies the negative contributions of `scaled_terms` (None: every
-    term) -- the reward curriculum; 1 is the paper's table. `only_positive` (legged_gym's
+    term) and `boosts` the weights of the terms it names -- the reward curriculum; 1 and {}
+    are the paper's table. `only_positive` (legged_gym's
     `only_positive_rewards`) clips the sum of all terms but the termination penalty at zero
     before adding that penalty: while a young policy's penalties outweigh its rewards, living
     longer would otherwise cost more than falling early."""
     terms = {}
-    params = params or {}
+    params, boosts = params or {}, boosts or {}
     for name, weight in weights.items():
-        value = weight * REWARD_TERMS[name](ctx, **params.get(name, {})) * dt
+        value = (
+            weight * boosts.get(name, 1.0) * REWARD_TERMS[name](ctx, **params.get(name, {})) * dt
+        )
         if penalty_scale != 1.0 and (scaled_terms is None or name in scaled_terms):
             value = np.where(value < 0, penalty_scale * value, value)
         terms[name] = value
