@@ -174,7 +174,7 @@ def test_play_falls_back_to_gif(shipped_run: Path, tmp_path: Path) -> None:
     ("args", "message"),
     [
         (["cell=stairs-easy"], "cell: 'stairs-easy' is not <terrain>-<difficulty>"),
-        (["cell=stairs-easy"], "unknown 'easy'; allowed: ('medium', 'hard')"),
+        (["cell=stairs-easy"], "unknown 'easy'; allowed: ['hard', 'medium']"),
         (["task=ladder"], "task: unknown 'ladder'; allowed:"),
         (["seconds=-1"], "seconds: must be > 0"),
         (["--viewer"], "--viewer: needs a display"),

@@ -58,6 +58,8 @@ RESULT_COLUMNS = {
     "command_x",
 }
 
+pytestmark = pytest.mark.slow  # trains and evaluates runs: see README
+
 
 @pytest.fixture(scope="module")
 def cfg():

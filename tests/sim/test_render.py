@@ -113,6 +113,7 @@ def test_g1_standing_on_flat_ground_is_in_the_frame(flat_cfg, flat_scene) -> Non
     assert (change[~robot] > 30).mean() < 0.03  # (its outline aside)
 
 
+@pytest.mark.slow  # a subprocess that builds the scene and renders
 def test_scene_preview_cli(tmp_path: Path) -> None:
     """`python -m lca.scene terrain=stairs_up difficulty=hard scale=smoke preview=...`."""
     png = tmp_path / "terrain.png"

@@ -8,8 +8,12 @@ from omegaconf import MISSING
 
 from lca.config.errors import check_range, require
 from lca.config.registry import EVAL_TERRAINS, TILES
+from lca.paths import conf_dir
 
-DIFFICULTIES = ("medium", "hard")
+
+def difficulties() -> list[str]:
+    """The difficulty options (conf/difficulty/*.yaml): what an evaluation cell may name."""
+    return sorted(p.stem for p in (conf_dir() / "difficulty").glob("*.yaml"))
 
 
 @dataclass
@@ -53,8 +57,8 @@ class EvalConfig:
                 f"unknown evaluation terrain '{cell.terrain}'; allowed: {allowed}",
             )
             require(
-                cell.difficulty in DIFFICULTIES,
+                cell.difficulty in difficulties(),
                 f"eval.cells[{i}].difficulty",
-                f"unknown '{cell.difficulty}'; allowed: {DIFFICULTIES}",
+                f"unknown '{cell.difficulty}'; allowed: {difficulties()}",
             )
         check_range("eval.command_x", self.command_x, -1e9)

@@ -13,7 +13,6 @@ from hydra.core.config_store import ConfigStore
 
 from lca.config.errors import ConfigValueError  # noqa: F401 (re-exported)
 from lca.config.eval_schema import (  # noqa: F401 (re-exported)
-    DIFFICULTIES,
     EvalCell,
     EvalConfig,
 )
