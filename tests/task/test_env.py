@@ -87,6 +87,7 @@ def test_joint_groups_and_soft_limits(stand_env):
 
 def test_time_out_ends_every_episode_after_episode_length(stand_env):
     _, env = stand_env
+    env.reset_all()  # fresh episodes, whatever earlier tests did with the shared env
     n = env.num_envs
     assert isinstance(env, VecEnv)
     assert env.max_episode_length == 25  # 0.5 s at 50 Hz
