@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from omegaconf import MISSING
 
 from lca.config.errors import check_range, require
-from lca.config.registry import EVAL_TERRAINS, TILES
+from lca.config.registry import eval_terrain_names
 from lca.paths import conf_dir
 
 
@@ -46,19 +46,16 @@ class EvalConfig:
         require(
             self.video_seconds > 0, "eval.video_seconds", f"must be > 0, got {self.video_seconds}"
         )
+        allowed, levels = eval_terrain_names(), difficulties()
         for i, cell in enumerate(self.cells):
-            allowed = [
-                *EVAL_TERRAINS.names(),
-                *(t for t in TILES.names() if t not in EVAL_TERRAINS),
-            ]
             require(
                 cell.terrain in allowed,
                 f"eval.cells[{i}].terrain",
                 f"unknown evaluation terrain '{cell.terrain}'; allowed: {allowed}",
             )
             require(
-                cell.difficulty in difficulties(),
+                cell.difficulty in levels,
                 f"eval.cells[{i}].difficulty",
-                f"unknown '{cell.difficulty}'; allowed: {difficulties()}",
+                f"unknown '{cell.difficulty}'; allowed: {levels}",
             )
         check_range("eval.command_x", self.command_x, -1e9)

@@ -107,3 +107,10 @@ OBS_TERMS = Registry("observation term")  # name -> ObsTerm(dim, value) (task.ob
 REWARD_TERMS = Registry("reward term")  # name -> f(RewardContext) -> (N,) unweighted
 ACTORS = Registry("actor kind")  # name -> ActorSpec (learn.variants)
 ENCODERS = Registry("encoder kind")  # name -> rsl-rl encoder cfg "type"
+
+
+def eval_terrain_names() -> list[str]:
+    """What an evaluation cell may name, in table column order: the registered evaluation
+    terrains, then every tile not among them (a tile alone is a terrain of its own)."""
+    composites = EVAL_TERRAINS.names()
+    return [*composites, *(t for t in TILES.names() if t not in composites)]

@@ -84,7 +84,7 @@ def record(
     then, so its last frame is held, captioned."""
     stride = frame_stride(env.dt)
     rec = Recording(fps=clip_fps(env.dt))
-    steps_taken = rollout(env, policy, start(env, policy), steps=2**62)
+    steps_taken = rollout(env, policy, start(env, policy), steps=None)
     note, note_frames, steps = "", 0, 0
 
     def capture(text: str) -> None:

@@ -3,6 +3,7 @@ trials and the training probes. A recurrent policy's state restarts with each ep
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Iterator
 
 import torch
@@ -18,10 +19,12 @@ def start(env: LocomotionEnv, policy) -> TensorDict:
     return obs
 
 
-def rollout(env: LocomotionEnv, policy, obs: TensorDict, steps: int) -> Iterator[tuple[int, dict]]:
-    """Up to `steps` policy steps from `obs`, yielding (step, the env's per-unit metrics);
-    the caller stops early by leaving the loop."""
-    for step in range(steps):
+def rollout(
+    env: LocomotionEnv, policy, obs: TensorDict, steps: int | None
+) -> Iterator[tuple[int, dict]]:
+    """Up to `steps` policy steps from `obs` (None: until the caller stops), yielding
+    (step, the env's per-unit metrics); the caller stops early by leaving the loop."""
+    for step in range(steps) if steps is not None else itertools.count():
         with torch.inference_mode():
             obs, _, dones, extras = env.step(policy(obs))
         yield step, extras["metrics"]

@@ -4,7 +4,7 @@ label the tables print. Every registered tile is also an evaluation terrain of i
 
 from __future__ import annotations
 
-from lca.config.registry import EVAL_TERRAINS, TILES
+from lca.config.registry import EVAL_TERRAINS, TILES, eval_terrain_names
 
 # The paper's two table columns first: their order is the tables' column order.
 EVAL_TERRAINS.register("stairs", label="Stairs")({"stairs_up": 0.5, "stairs_down": 0.5})
@@ -14,9 +14,7 @@ EVAL_TERRAINS.register("mixed", label="Mixed")(
 )
 
 
-def eval_terrains() -> list[str]:
-    """Every evaluation terrain, in table column order."""
-    return [*EVAL_TERRAINS.names(), *(t for t in TILES.names() if t not in EVAL_TERRAINS)]
+eval_terrains = eval_terrain_names  # every evaluation terrain, in table column order
 
 
 def eval_mixture(name: str) -> dict[str, float]:

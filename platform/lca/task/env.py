@@ -36,14 +36,8 @@ from lca.task.state import (
 from lca.task.step_metrics import step_metrics
 from lca.task.terminations import fell, non_finite
 
-BAD_STATE_WARNINGS = [
-    int(w)
-    for w in (
-        mujoco.mjtWarning.mjWARN_BADQPOS,
-        mujoco.mjtWarning.mjWARN_BADQVEL,
-        mujoco.mjtWarning.mjWARN_BADQACC,
-    )
-]
+_W = mujoco.mjtWarning
+BAD_STATE_WARNINGS = [int(w) for w in (_W.mjWARN_BADQPOS, _W.mjWARN_BADQVEL, _W.mjWARN_BADQACC)]
 
 
 class EnvConfig:
@@ -84,8 +78,9 @@ class LocomotionEnv(VecEnv):
         mid, half = (lower + upper) / 2, (upper - lower) / 2 * task.reward_params.soft_limit_factor
         self.joint_lower, self.joint_upper = mid - half, mid + half
         self.weights, self.reward_term_params = weights_and_params(task.rewards)
-        terms = [REWARD_TERMS[name] for name in self.weights]
-        self._stateful_terms = [t.reset for t in terms if callable(getattr(t, "reset", None))]
+        self.reward_fns = {name: REWARD_TERMS[name] for name in self.weights}
+        fns = self.reward_fns.values()
+        self._stateful_terms = [f.reset for f in fns if callable(getattr(f, "reset", None))]
         # the reward curriculum's knobs (lca.learn.reward_curriculum); the paper's: 1, False
         self.penalty_scale, self.boosts = 1.0, {}
         self.only_positive = bool(task.only_positive_rewards)
@@ -175,6 +170,7 @@ class LocomotionEnv(VecEnv):
             self.scaled_terms,
             self.reward_term_params,
             self.boosts,
+            self.reward_fns,
         )
         for name, value in terms.items():
             self.episode_sums[name] += value

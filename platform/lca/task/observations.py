@@ -9,7 +9,7 @@ the scale applied (IsaacLab's order). The history holds K frames of the proprioc
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -19,13 +19,15 @@ from lca.task.state import RobotState
 
 @dataclass(frozen=True)
 class Term:
-    """One declared observation term (task.observations), with its dimension resolved."""
+    """One declared observation term (task.observations), resolved: its dimension and the
+    registered function that reads its raw value (looked up once, not every step)."""
 
     name: str
     dim: int
     scale: float | tuple[float, ...] = 1.0
     noise: float = 0.0  # half-width of uniform noise on the raw value
     clip: float | None = None
+    value: Callable[[ObsInputs], np.ndarray] | None = field(default=None, compare=False)
 
 
 @dataclass
@@ -53,7 +55,8 @@ def terms(declared, num_joints: int) -> tuple[Term, ...]:
         scale = (
             tuple(float(x) for x in t.scale) if not isinstance(t.scale, int | float) else t.scale
         )
-        out.append(Term(t.name, OBS_TERMS[t.name].dim(num_joints), scale, t.noise, t.clip))
+        term = OBS_TERMS[t.name]
+        out.append(Term(t.name, term.dim(num_joints), scale, t.noise, t.clip, term.value))
     return tuple(out)
 
 
@@ -72,7 +75,7 @@ def build(
     version), times its scale, clipped; noise before scale, as IsaacLab does."""
     parts = []
     for term in declared:
-        value = OBS_TERMS[term.name].value(inputs)
+        value = term.value(inputs)
         if rng is not None and term.noise > 0:
             value = value + rng.uniform(-term.noise, term.noise, value.shape)
         value = value * np.asarray(term.scale)

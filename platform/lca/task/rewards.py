@@ -7,6 +7,7 @@ Rewards section: contact C_i = 1(|F_i| > F*), stance intent s_i = 1(phi_i < tau 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -218,18 +219,21 @@ def compute_rewards(
     scaled_terms: frozenset[str] | None = None,
     params: dict[str, dict] | None = None,
     boosts: dict[str, float] | None = None,
+    fns: dict[str, Callable] | None = None,
 ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Total reward and each weighted term, (N,). Terms are per second of simulated time,
     scaled by the policy step `dt`, so weights do not depend on the control rate.
 
     `penalty_scale` multiplies the negative contributions of `scaled_terms` (None: every
     term) and `boosts` the weights of the terms it names -- the reward curriculum; 1 and {}
-    are the paper's table. `only_positive` (legged_gym's
+    are the paper's table. `fns` are the registered term functions, resolved once by the env
+    (looked up here when not given). `only_positive` (legged_gym's
     `only_positive_rewards`) clips the sum of all terms but the termination penalty at zero
     before adding that penalty: while a young policy's penalties outweigh its rewards, living
     longer would otherwise cost more than falling early."""
     terms = {}
     params, boosts = params or {}, boosts or {}
+    fns = fns or {name: REWARD_TERMS[name] for name in weights}
     for name, weight in weights.items():
         value = (
             weight * boosts.get(name, 1.0) * REWARD_TERMS[name](ctx, **params.get(name, {})) * dt

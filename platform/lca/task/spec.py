@@ -15,6 +15,7 @@ from lca.task.terminations import TERMINATIONS
 
 def _term(term: observations.Term, history: int = 1, noisy: bool = True) -> dict:
     d = asdict(term)
+    d.pop("value")  # the function that reads it: not part of the description
     d["dim"] = term.dim * history
     d["scale"] = list(term.scale) if isinstance(term.scale, tuple) else term.scale
     d["noise"] = term.noise if noisy else 0.0
@@ -28,6 +29,7 @@ def describe_task(cfg: DictConfig) -> dict:
     spec = build_robot_spec(cfg.robot)
     num_joints = sum(1 for j in spec.joints if j.type == mujoco.mjtJoint.mjJNT_HINGE)
     k = task.observations.history
+    weights, params = weights_and_params(task.rewards)
     noisy = bool(task.observations.noise)
     hist = observations.history_terms(task.observations, num_joints)
     current = observations.current_terms(task.observations, num_joints)
@@ -68,8 +70,8 @@ def describe_task(cfg: DictConfig) -> dict:
     return {
         "observations": described,
         "actions": {"dim": num_joints, "scale": task.action_scale, "clip": task.action_clip},
-        "rewards": weights_and_params(task.rewards)[0],
-        "reward_term_params": weights_and_params(task.rewards)[1],
+        "rewards": weights,
+        "reward_term_params": params,
         "only_positive_rewards": bool(task.only_positive_rewards),
         "reward_params": OmegaConf.to_container(task.reward_params),
         "commands": OmegaConf.to_container(task.commands),
