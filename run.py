@@ -10,6 +10,7 @@ from hydra.core.hydra_config import HydraConfig
 from omegaconf import DictConfig
 
 import lca.config
+from lca.config.policies import label_policy
 from lca.pipeline import run_pipeline
 
 
@@ -17,6 +18,7 @@ from lca.pipeline import run_pipeline
 def main(cfg: DictConfig) -> dict | None:
     lca.config.validate(cfg)
     hydra_cfg = HydraConfig.get()
+    label_policy(cfg, hydra_cfg.searchpath)
     return run_pipeline(
         cfg,
         Path(hydra_cfg.runtime.output_dir),

@@ -2,9 +2,10 @@
 
     python -m lca.ship <run_dir> <dest> [--resumable]
 
-Kept: config.yaml, provenance.json, train_curve.csv, the in-training evaluations, summary.csv
-and results.parquet (when evaluated), exported/ (ONNX + TorchScript) and the final
-checkpoint without its optimizer state (evaluation and export need only the networks).
+Kept: config.yaml, provenance.json, train_cfg.json, train_curve.csv, the in-training
+evaluations, summary.csv and results.parquet (when evaluated), exported/ (ONNX +
+TorchScript) and the final checkpoint without its optimizer state (evaluation and export
+need only the networks).
 `--resumable` ships `checkpoints/latest.pt` whole instead, so an unfinished training can be
 resumed by a later session (`cp -r dest runs/...` and re-run the same command).
 """
@@ -21,6 +22,7 @@ import torch
 FILES = (
     "config.yaml",
     "provenance.json",
+    "train_cfg.json",
     "train_curve.csv",
     "probe_evals.csv",
     "summary.csv",

@@ -27,6 +27,7 @@ LOCK = ".lock"
 _HELD: dict[Path, int] = {}  # run directories this process has locked -> nesting depth
 PACKAGES = ("lca", "torch", "mujoco", "mjbatch", "rsl-rl-lib", "hydra-core", "numpy", "tensordict")
 COMPLETE = "COMPLETE"
+TRAIN_CFG = "train_cfg.json"
 FAILED = "FAILED"
 KEEP_ON_FORCE = (".hydra", LOCK)  # Hydra writes .hydra/ before the job starts
 
@@ -186,6 +187,20 @@ class RunDir:
             "departures_from_paper": departures(cfg),
         }
         atomic_write(self.path / "provenance.json", json.dumps(provenance, indent=2))
+
+    def write_train_cfg(self, train_cfg: dict) -> None:
+        """The rsl-rl runner config the run trains with: evaluation rebuilds the networks
+        from it (class names resolved by rsl-rl) without the learning stage's code."""
+        atomic_write(self.path / TRAIN_CFG, json.dumps(train_cfg, indent=2))
+
+    def train_cfg(self) -> dict:
+        path = self.path / TRAIN_CFG
+        if not path.exists():
+            raise FileNotFoundError(
+                f"run_dir: {self.path} has no {TRAIN_CFG} (the networks to load); "
+                "train it (or re-run it with force=true) first"
+            )
+        return json.loads(path.read_text())
 
     def latest_checkpoint(self) -> Path | None:
         path = self.checkpoints / "latest.pt"

@@ -10,6 +10,7 @@ import torch
 
 from lca.config.schema import EvalCell
 from lca.evaluate.probe import PROBE_FIELDS, TrainingProbe
+from lca.learn.train_cfg import build_train_cfg
 from lca.learn.trainer import Trainer
 from lca.sim.scene import Scene, build_scene
 from lca.store import RunDir
@@ -52,7 +53,9 @@ def _train(tmp_path, scene, name: str, probe: TrainingProbe | None):
 
 def test_probe_rows_and_untouched_training(tmp_path, smoke_scene):
     cfg = smoke_cfg("scale.max_iterations=3", "seed=3")
-    probe = TrainingProbe(cfg, tmp_path / "probe.csv", EvalCell("flat", "medium"), 3, 30)
+    probe = TrainingProbe(
+        cfg, tmp_path / "probe.csv", EvalCell("flat", "medium"), 3, 30, build_train_cfg(cfg, "p")
+    )
     with_probe = _train(tmp_path, smoke_scene, "with", probe)
     without = _train(tmp_path, smoke_scene, "without", None)
 
@@ -75,7 +78,9 @@ def test_probe_rows_and_untouched_training(tmp_path, smoke_scene):
 def test_probe_is_repeatable(tmp_path, smoke_scene):
     cfg = smoke_cfg("seed=3")
     trainer = make_trainer(cfg, tmp_path / "run", smoke_scene)
-    probe = TrainingProbe(cfg, tmp_path / "p.csv", EvalCell("flat", "medium"), 3, 30)
+    probe = TrainingProbe(
+        cfg, tmp_path / "p.csv", EvalCell("flat", "medium"), 3, 30, build_train_cfg(cfg, "p")
+    )
     actor = trainer.alg.get_policy()
     first, second = probe.evaluate(actor), probe.evaluate(actor)
     first.pop("eval_s"), second.pop("eval_s")

@@ -137,7 +137,7 @@ def test_a_locked_run_directory_is_refused_by_evaluation(tmp_path):
     _, run = train_tiny_run(tmp_path / "run")
     hold = (
         "import sys, time; from lca.store import RunDir\n"
-        "with RunDir(sys.argv[1]).lock():\n    print('locked', flush=True); time.sleep(60)\n"
+        "with RunDir(sys.argv[1]).lock():\n    print('locked', flush=True); time.sleep(600)\n"
     )
     holder = subprocess.Popen([sys.executable, "-c", hold, str(run.path)], stdout=subprocess.PIPE)
     try:

@@ -19,6 +19,7 @@ SHIPPED = Path(__file__).resolve().parents[2] / "assets" / "policies" / "blind_f
 FILES = (
     "config.yaml",
     "provenance.json",
+    "train_cfg.json",
     "train_curve.csv",
     "exported/policy.onnx",
     "exported/policy.pt",

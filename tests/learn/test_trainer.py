@@ -14,6 +14,7 @@ import pytest
 import torch
 
 from lca.learn.run import train_run
+from lca.learn.train_cfg import build_train_cfg
 from lca.store import RunDir
 
 from .helpers import WANDB_KEYS, make_trainer, read_curve, smoke_cfg
@@ -77,6 +78,9 @@ def test_combination_trains(actor, encoder, curriculum, smoke_scene, tmp_path) -
     assert saved["infos"] == {"stage": STAGES[curriculum][-1], "penalty_scale": 1.0}
     _assert_architecture(saved["actor_state_dict"], actor, encoder)
     _assert_architecture(saved["critic_state_dict"], None, encoder)
+    # what evaluation rebuilds the networks from
+    written = json.loads((trainer.run.path / "train_cfg.json").read_text())
+    assert written == build_train_cfg(cfg, trainer.run.path.name)
     assert "rnn.rnn.weight_ih_l0" not in saved["critic_state_dict"]
     # the checkpoint holds the weights the trainer ended with
     policy = trainer.alg.get_policy().state_dict()

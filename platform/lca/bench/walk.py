@@ -29,6 +29,7 @@ from lca.config import compose  # noqa: E402
 from lca.config.runtime import set_torch_threads  # noqa: E402
 from lca.config.schema import EvalCell  # noqa: E402
 from lca.evaluate.probe import TrainingProbe  # noqa: E402
+from lca.learn.train_cfg import build_train_cfg  # noqa: E402
 from lca.learn.trainer import Trainer  # noqa: E402
 from lca.paths import reports_dir
 from lca.store import RunDir  # noqa: E402
@@ -85,8 +86,14 @@ def run(args: list[str], log: Callable[[str], None] | None = print) -> dict:
     run.path.mkdir(parents=True, exist_ok=True)
     run.write_provenance(cfg, overrides, {"bench": "walk"})
     set_torch_threads(int(cfg.torch_threads))
+    # the probe's networks are built before the trainer's, as always: the trainer seeds torch
     probe = TrainingProbe(
-        cfg, run.path / "probe_evals.csv", FLAT_CELL, cfg.eval.units, cfg.eval.steps
+        cfg,
+        run.path / "probe_evals.csv",
+        FLAT_CELL,
+        cfg.eval.units,
+        cfg.eval.steps,
+        build_train_cfg(cfg, run.path.name),
     )
     trainer = Trainer(cfg, run)
     state = {"next": 0.0, "walked": None}

@@ -4,10 +4,12 @@ from __future__ import annotations
 
 from hydra import compose as hydra_compose
 from hydra import initialize_config_dir
+from hydra.core.override_parser.overrides_parser import OverridesParser
 from omegaconf import DictConfig, OmegaConf
 from omegaconf.errors import ConfigKeyError, ValidationError
 
 from lca.config import schema
+from lca.config.policies import label_policy
 from lca.config.schema import ConfigValueError
 from lca.paths import conf_dir
 
@@ -53,7 +55,16 @@ def compose(overrides: list[str] | None = None, config_name: str = "config") -> 
     with initialize_config_dir(config_dir=str(conf_dir()), version_base="1.3"):
         cfg = hydra_compose(config_name=config_name, overrides=list(overrides or []))
     validate(cfg)
+    label_policy(cfg, searchpath(overrides or []))
     return cfg
+
+
+def searchpath(overrides: list[str]) -> list[str]:
+    """The `hydra.searchpath=[...]` folders named in `overrides` (none: [])."""
+    for parsed in OverridesParser.create().parse_overrides(list(overrides)):
+        if parsed.key_or_group == "hydra.searchpath":
+            return [str(v) for v in parsed.value()]
+    return []
 
 
 def _delta(before, after):

@@ -141,3 +141,24 @@ class ScaleConfig:
         for key in ("max_iterations", "log_interval", "checkpoint_interval"):
             value = getattr(self, key)
             require(value >= 1, f"scale.{key}", f"must be >= 1, got {value}")
+
+
+MATCH_KEYS = {"curriculum": "curriculum.name", "actor": "actor.kind", "encoder": "encoder.kind"}
+
+
+@dataclass
+class PolicyConfig:
+    """The report's name for a run: set by a `conf/policy/*.yaml` option, or filled at
+    composition from the policy file whose `match` equals the run (lca.config.policies)."""
+
+    label: str = ""  # the table row, e.g. "Two-Stage MLP"; "" = not resolved yet
+    row: int = 100  # position of the row in tables (smaller first)
+    # which runs the label names: curriculum (name), actor and encoder (kinds); an absent key
+    # matches any value (the blind policy's actor never sees the encoder)
+    match: dict[str, str] = field(default_factory=dict)
+
+    def check(self) -> None:
+        unknown = sorted(set(self.match) - set(MATCH_KEYS))
+        require(
+            not unknown, "policy.match", f"unknown keys {unknown}; allowed: {sorted(MATCH_KEYS)}"
+        )

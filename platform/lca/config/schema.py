@@ -31,6 +31,7 @@ from lca.config.learn_schema import (  # noqa: F401 (re-exported)
     CurriculumConfig,
     EncoderConfig,
     LoggerConfig,
+    PolicyConfig,
     ScaleConfig,
 )
 from lca.config.sim_schema import (  # noqa: F401 (re-exported)
@@ -77,6 +78,7 @@ class LcaConfig:
     eval: EvalConfig = field(default_factory=EvalConfig)
     logger: LoggerConfig = field(default_factory=LoggerConfig)
     scale: ScaleConfig = field(default_factory=ScaleConfig)
+    policy: PolicyConfig = field(default_factory=PolicyConfig)
 
 
 def register() -> None:

@@ -19,11 +19,10 @@ import numpy as np
 import torch
 from omegaconf import DictConfig
 
-from lca.evaluate.policy import load_policy
+from lca.evaluate.policy import load_policy, sees_map
 from lca.evaluate.protocol import cell_config, cell_name, round_seed
 from lca.evaluate.rollout import rollout, start
 from lca.evaluate.video import Telemetry, overlay, write_clip, write_png
-from lca.learn import curriculum
 from lca.sim import render
 from lca.sim.terrain import Terrain
 from lca.task.env import LocomotionEnv
@@ -64,12 +63,6 @@ def gl_missing(run_name: str, log) -> bool:
             f"eval.videos=false turns clips off"
         )
     return reason is not None
-
-
-def perception_of(cfg: DictConfig) -> bool:
-    """Whether the run's final policy sees its map (two-stage: yes; blind: no)."""
-    total = int(cfg.scale.max_iterations)
-    return curriculum.perception_on(cfg.curriculum, total - 1, total)
 
 
 @torch.inference_mode()
@@ -186,7 +179,7 @@ def cell_setting(cfg: DictConfig, cell, checkpoint: Path, seconds: float) -> Set
     """One unit of evaluation `cell`, seeded like the cell's first round, for `seconds`."""
     c = clip_config(cell_config(cfg, cell), seconds)
     env = LocomotionEnv(c)
-    env.set_perception(perception_of(cfg))
+    env.set_perception(sees_map(checkpoint))
     policy = load_policy(c, env, checkpoint)
     env.reseed(round_seed(c.eval.seed, cell, 0))
     return Setting(c, env, policy, cell_name(cell), env.scene.terrain)

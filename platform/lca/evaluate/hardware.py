@@ -21,11 +21,10 @@ import torch
 from omegaconf import DictConfig
 
 from lca.config import load_option
-from lca.evaluate.clips import Setting, gl_missing, perception_of, save, shoot
-from lca.evaluate.policy import final_checkpoint, load_policy
+from lca.evaluate.clips import Setting, gl_missing, save, shoot
+from lca.evaluate.policy import final_checkpoint, load_policy, sees_map
 from lca.evaluate.protocol import trial_config
 from lca.evaluate.rollout import rollout, start
-from lca.learn import curriculum
 from lca.sim.hardware import HardwareTask, build_task
 from lca.store import RunDir, atomic_write
 from lca.task.env import LocomotionEnv
@@ -83,9 +82,8 @@ def run_hardware(run_dir: Path, cfg: DictConfig, log=print) -> pd.DataFrame:
 
 def _run_hardware(run_dir: Path, cfg: DictConfig, log) -> pd.DataFrame:
     c = task_config(cfg)
-    total = int(cfg.scale.max_iterations)
-    perception = curriculum.perception_on(cfg.curriculum, total - 1, total)
     checkpoint = final_checkpoint(run_dir)
+    perception = sees_map(checkpoint)
     steps = int(round(c.hardware.time_limit_s / (c.sim.timestep * c.sim.decimation)))
     frames = []
     for name in c.hardware.tasks:
@@ -122,7 +120,7 @@ def hardware_setting(cfg: DictConfig, name: str, checkpoint: Path) -> Setting:
     c = task_config(one)
     task, scene = build_task(c, name)
     env = LocomotionEnv(c, scene=scene)
-    env.set_perception(perception_of(cfg))
+    env.set_perception(sees_map(checkpoint))
     env.reseed(c.eval.seed)
     policy = load_policy(c, env, checkpoint)
 

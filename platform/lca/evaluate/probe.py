@@ -38,13 +38,16 @@ PROBE_FIELDS = (
 
 
 class TrainingProbe:
-    def __init__(self, cfg: DictConfig, out: Path, cell: EvalCell, units: int, steps: int):
+    def __init__(
+        self, cfg: DictConfig, out: Path, cell: EvalCell, units: int, steps: int, train_cfg: dict
+    ):
+        """`train_cfg`: the rsl-rl runner config of the training (the networks to copy into)."""
         cfg = copy.deepcopy(cfg)
         cfg.eval.units, cfg.eval.steps = int(units), int(steps)
         self.cell = OmegaConf.structured(cell)
         self.env = LocomotionEnv(cell_config(cfg, self.cell))
         self.env.set_perception(False)
-        self.policy = new_policy(cfg, self.env)
+        self.policy = new_policy(cfg, self.env, train_cfg)
         self.seed = int(cfg.eval.seed)
         self.steps = int(steps)
         self.out = Path(out)

@@ -22,10 +22,9 @@ from omegaconf import DictConfig, OmegaConf
 
 from lca.config import load_option
 from lca.evaluate.metrics import episode_metrics
-from lca.evaluate.policy import final_checkpoint, load_policy
+from lca.evaluate.policy import final_checkpoint, load_policy, sees_map
 from lca.evaluate.rollout import rollout, start
 from lca.evaluate.terrains import eval_mixture
-from lca.learn import curriculum
 from lca.store import atomic_write
 from lca.task.env import LocomotionEnv
 from lca.testhook import exit_point
@@ -101,8 +100,7 @@ def evaluate_run(run_dir: Path, cfg: DictConfig, log=print) -> pd.DataFrame:
     run_dir = Path(run_dir)
     ev = cfg.eval
     checkpoint = final_checkpoint(run_dir)
-    total = int(cfg.scale.max_iterations)
-    perception = curriculum.perception_on(cfg.curriculum, total - 1, total)
+    perception = sees_map(checkpoint)
     out_dir = run_dir / "eval"
     _discard_stale_rounds(out_dir, ev, log)
     written = 0

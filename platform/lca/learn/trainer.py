@@ -98,6 +98,7 @@ class Trainer:
             None if cfg.logger.name == "none" else str(run_dir.path / "logs" / run_dir.path.name)
         )
         train_cfg = build_train_cfg(cfg, run_dir.path.name)
+        run_dir.write_train_cfg(train_cfg)  # before the runner edits the dict in place
         with contextlib.redirect_stdout(io.StringIO()):  # rsl-rl prints the model summaries
             self.runner = OnPolicyRunner(self.env, train_cfg, log_dir=log_dir, device=self.device)
         self.alg = self.runner.alg

@@ -4,51 +4,43 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass
+from functools import cache
 from pathlib import Path
 
 import pandas as pd
-from omegaconf import OmegaConf
+from omegaconf import DictConfig, OmegaConf
 
-from lca.config.registry import ACTORS, ENCODERS
-
-ROW_ORDER = [
-    "Blind",
-    "One-Stage MLP",
-    "Two-Stage MLP",
-    "One-Stage LSTM",
-    "Two-Stage LSTM",
-    "One-Stage CNN",
-    "Two-Stage CNN",
-]
-STAGES = {"one": "One-Stage", "two": "Two-Stage"}
-
+from lca.config.policies import known_policies, matching_policy, unlabelled_error
 
 POOLED = " (pooled)"  # a CNN with max-pooling is not the paper's CNN
+# label -> row of every policy block seen (conf/policy/*.yaml and the runs loaded so far)
+_ROWS: dict[str, int] = {}
 
 
-def policy_label(curriculum: str, actor: str, encoder: str, pool: int = 0) -> str:
-    """The paper's row name, from the run's composed config (never from folder names) and the
-    registered labels of its actor and encoder kinds (lca.learn.variants).
+def policy_label(cfg: DictConfig, where: str = "run") -> tuple[str, int]:
+    """(row name, row number) of a run: the `policy` block that composition put into its
+    config.yaml from conf/policy/*.yaml (never from folder names). A config older than those
+    blocks is matched against the project's policy files now. A run that matches none fails
+    loudly, naming its choices and the known policies: nothing is pooled into another row.
+    A CNN encoder with max-pooling (`encoder.pool`) reads "<label> (pooled)"."""
+    policy = cfg.get("policy")
+    if not (policy and policy.get("label")):
+        policy = matching_policy(cfg)
+    if policy is None:
+        raise ValueError(unlabelled_error(where, cfg))
+    _ROWS[policy.label] = int(policy.row)
+    pooled = POOLED if cfg.encoder.kind == "cnn" and int(cfg.encoder.get("pool", 0)) > 1 else ""
+    return policy.label + pooled, int(policy.row)
 
-    MLP = MLP actor + MLP encoder, CNN = MLP actor + CNN encoder, LSTM = LSTM actor
-    (+ MLP encoder; with a CNN encoder it is reported as LSTM-CNN), and likewise for any
-    registered actor kind. A CNN encoder with max-pooling (`encoder.pool`) reads
-    "CNN (pooled)". A kind nobody registered fails loudly, naming the allowed ones."""
-    if curriculum == "blind":
-        return "Blind"
-    actor_label = ACTORS.label(actor)
-    encoder_label = ENCODERS.label(encoder)
-    if actor == "mlp":
-        arch = encoder_label
-    else:
-        arch = actor_label if encoder == "mlp" else f"{actor_label}-{encoder_label}"
-    pooled = POOLED if encoder == "cnn" and pool > 1 else ""
-    return f"{STAGES.get(curriculum, curriculum)} {arch}{pooled}"
+
+@cache
+def _project_rows() -> dict[str, int]:
+    return {p.label: p.row for p in known_policies().values()}
 
 
 def row_key(label: str) -> tuple[int, str]:
     base = label.removesuffix(POOLED)
-    return (ROW_ORDER.index(base) if base in ROW_ORDER else len(ROW_ORDER), label)
+    return (_ROWS.get(base, _project_rows().get(base, 1000)), label)
 
 
 @dataclass
@@ -104,9 +96,7 @@ def load_run(path: Path) -> RunRecord:
     hardware = path / "hardware.csv"
     return RunRecord(
         path=path,
-        label=policy_label(
-            cfg.curriculum.name, cfg.actor.kind, cfg.encoder.kind, int(cfg.encoder.get("pool", 0))
-        ),
+        label=policy_label(cfg, str(path))[0],
         curriculum=cfg.curriculum.name,
         actor=cfg.actor.kind,
         encoder=cfg.encoder.kind,
