@@ -13,6 +13,8 @@ import lca.config
 from lca.config.policies import label_policy
 from lca.pipeline import run_pipeline
 
+lca.config.schema.register()  # `lca_schema`, assembled from every layer's config groups
+
 
 @hydra.main(config_path="conf", config_name="config", version_base="1.3")
 def main(cfg: DictConfig) -> dict | None:

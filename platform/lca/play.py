@@ -24,11 +24,12 @@ from omegaconf import OmegaConf
 
 from lca.cli import split_option
 from lca.config import ConfigError
-from lca.config.schema import HARDWARE_TASKS, EvalCell, EvalConfig
 from lca.evaluate.clips import Setting, cell_setting, save, shoot
+from lca.evaluate.config import EvalCell, EvalConfig
 from lca.evaluate.hardware import hardware_setting
 from lca.evaluate.policy import final_checkpoint, load_run_config
 from lca.evaluate.protocol import cell_name
+from lca.sim.config import HARDWARE_TASKS
 from lca.sim.render import gl_unavailable
 
 USAGE = (

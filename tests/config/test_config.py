@@ -77,7 +77,7 @@ def test_unknown_terrain_type_in_mixture(override: str) -> None:
         (["task.reward_curriculum.terms=[joy]"], "task.reward_curriculum.terms"),
         (["actor.final_noise_std=2.0"], "actor.final_noise_std"),
         (["terrain.apron=-1"], "terrain.apron"),
-        # one row per remaining check of the schema (lca/config/*_schema.py)
+        # one row per remaining check of the groups (lca/<layer>/config.py)
         (["sim.timestep=0"], "sim.timestep"),
         (["sim.decimation=0"], "sim.decimation"),
         (["sim.integrator=verlet"], "sim.integrator"),
@@ -161,3 +161,12 @@ def test_dead_key_scale_num_envs_is_gone() -> None:
     with pytest.raises((ConfigCompositionException, ConfigError)) as err:
         compose(["scale.num_envs=-5"])
     assert "scale.num_envs" in str(err.value)
+
+
+@pytest.mark.parametrize(
+    "override", ["+task.typo_key=1", "+task.reward_params.sigma=1", "+seeds=1", "+eval.cell=x"]
+)
+def test_an_appended_key_outside_the_schema_fails_at_composition(override: str) -> None:
+    key = override[1:].split("=")[0]
+    with pytest.raises(ConfigError, match=rf"^{key}: not in the schema"):
+        compose([override])

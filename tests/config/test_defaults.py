@@ -1,15 +1,19 @@
-"""One set of defaults: every value a group's default option (conf/<group>/<default>.yaml)
-sets equals the schema dataclass's default, so the code and the YAML cannot drift apart."""
+"""One source of defaults. Every value is set in exactly one place: the group's dataclass
+(lca.<layer>.config), or, for the tables a dataclass leaves MISSING or empty (observation and
+reward terms, the robot's actuators and home pose, a terrain's mixture), the group's default
+option in conf/. No default option restates a dataclass default, so the two cannot drift
+apart; the composed default config is exactly the dataclasses plus those tables."""
 
 from __future__ import annotations
 
 import pytest
 from omegaconf import OmegaConf
 
-from lca.config import schema
+from lca.config import compose, schema
 from lca.paths import conf_dir
 
 DEFAULTS = OmegaConf.load(conf_dir() / "config.yaml").defaults
+UNSET = ("???", {}, [], None)  # a dataclass field whose value only the YAML gives
 
 
 def default_options() -> list[tuple[str, str]]:
@@ -23,24 +27,26 @@ def default_options() -> list[tuple[str, str]]:
     return options
 
 
-def disagreements(code, yaml, key: str) -> list[str]:
-    if isinstance(yaml, dict):
+def restated(code, yaml, key: str) -> list[str]:
+    """The leaves `yaml` sets that the dataclass (`code`) already sets."""
+    if isinstance(yaml, dict) and isinstance(code, dict) and code not in UNSET:
         out = []
         for k, v in yaml.items():
-            if isinstance(code, dict) and k in code:
-                out += disagreements(code[k], v, f"{key}.{k}")
+            out += restated(code[k], v, f"{key}.{k}") if k in code else []
         return out
-    if isinstance(yaml, list) and isinstance(code, list) and len(yaml) == len(code):
-        out = []
-        for i, (c, y) in enumerate(zip(code, yaml, strict=True)):
-            out += disagreements(c, y, f"{key}[{i}]")
-        return out
-    if code == "???":  # MISSING in the schema: the YAML is the one source
-        return []
-    same = code == yaml or (
-        isinstance(code, int | float) and isinstance(yaml, int | float) and abs(code - yaml) < 1e-12
-    )
-    return [] if same else [f"{key}: code {code!r} != yaml {yaml!r}"]
+    return [] if code in UNSET else [f"{key} = {yaml!r} (the dataclass says {code!r})"]
+
+
+def option_values(group: str, name: str) -> dict:
+    yaml = OmegaConf.to_container(OmegaConf.load(conf_dir() / group / f"{name}.yaml")) or {}
+    yaml.pop("defaults", None)
+    if group == "scale":  # a global package: its keys are the scale's changes to other groups
+        yaml = yaml.get("scale", {})
+    return yaml
+
+
+def code_defaults() -> dict:
+    return OmegaConf.to_container(OmegaConf.structured(schema.root()), resolve=False)
 
 
 def test_the_default_options_are_found() -> None:
@@ -49,17 +55,27 @@ def test_the_default_options_are_found() -> None:
 
 
 @pytest.mark.parametrize(("group", "name"), default_options())
-def test_default_option_equals_the_schema_defaults(group: str, name: str) -> None:
-    code = OmegaConf.to_container(OmegaConf.structured(schema.LcaConfig), resolve=False)
-    yaml = OmegaConf.to_container(OmegaConf.load(conf_dir() / group / f"{name}.yaml"))
-    yaml.pop("defaults", None)
-    if group == "scale":  # a global package: its other keys are the scale's deliberate changes
-        yaml = yaml["scale"]
-    assert disagreements(code[group], yaml, group) == []
+def test_no_default_option_restates_the_dataclass(group: str, name: str) -> None:
+    assert restated(code_defaults()[group], option_values(group, name), group) == []
 
 
-def test_a_drifted_default_is_caught() -> None:
-    assert disagreements({"a": {"b": [8, 16]}}, {"a": {"b": [16, 16]}}, "x") == [
-        "x.a.b[0]: code 8 != yaml 16"
+def test_the_composed_defaults_are_the_dataclasses_plus_the_yaml_tables() -> None:
+    expected = OmegaConf.structured(schema.root())
+    for group, name in default_options():
+        if group != "scale":
+            expected[group] = OmegaConf.merge(expected[group], option_values(group, name))
+    scale = OmegaConf.load(conf_dir() / "scale" / "cpu.yaml")  # the default scale's changes
+    scale.pop("defaults", None)
+    expected = OmegaConf.merge(expected, scale)
+    composed = compose([])
+    got = OmegaConf.to_container(composed, resolve=True)
+    want = OmegaConf.to_container(expected, resolve=True)
+    want["policy"] = got["policy"]  # filled at composition from conf/policy (test_policies)
+    assert got == want
+
+
+def test_a_restated_default_is_caught() -> None:
+    assert restated({"a": {"b": [8, 16]}}, {"a": {"b": [8, 16]}}, "x") == [
+        "x.a.b = [8, 16] (the dataclass says [8, 16])"
     ]
-    assert disagreements({"a": [1]}, {"a": [1, 2]}, "x") == ["x.a: code [1] != yaml [1, 2]"]
+    assert restated({"a": "???", "m": {}}, {"a": [1], "m": {"flat": 1.0}}, "x") == []

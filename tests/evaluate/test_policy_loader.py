@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from omegaconf import OmegaConf
 
-from lca.config.schema import EvalCell
+from lca.evaluate.config import EvalCell
 from lca.evaluate.policy import final_checkpoint, load_policy, load_run_config, sees_map
 from lca.evaluate.protocol import cell_config
 from lca.task.env import LocomotionEnv

@@ -8,7 +8,7 @@ import csv
 import pytest
 import torch
 
-from lca.config.schema import EvalCell
+from lca.evaluate.config import EvalCell
 from lca.evaluate.probe import PROBE_FIELDS, TrainingProbe
 from lca.learn.train_cfg import build_train_cfg
 from lca.learn.trainer import Trainer

@@ -346,3 +346,26 @@ def test_soft_mat_gives_much_more_than_rigid_ground(cfg):
     assert contacts
     np.testing.assert_allclose(contacts[0].solref, m.solref)
     np.testing.assert_allclose(contacts[0].solimp, m.solimp)
+
+
+# ---- python -m lca.hardware.scenes -------------------------------------------------------
+
+
+def test_scenes_command_writes_each_task_as_a_loadable_model(tmp_path, capsys) -> None:
+    from lca.hardware import scenes
+
+    assert scenes.main(["scale=smoke", f"out={tmp_path}"]) == 0
+    written = sorted(p.stem for p in tmp_path.glob("*.mjb"))
+    assert written == sorted(TASKS)
+    assert capsys.readouterr().out.count("wrote ") == len(TASKS)
+    robot = build_scene(compose(["scale=smoke"])).model
+    for name in TASKS:
+        model = mujoco.MjModel.from_binary_path(str(tmp_path / f"{name}.mjb"))
+        assert model.nu == robot.nu  # the G1's actuators, unchanged
+        assert model.nkey >= 1  # starts from `home`
+        # the task geometry is there: the hinged ledge adds its plank's hinge
+        assert (model.njnt > robot.njnt) == (name == "hinged_ledge"), name
+        data = mujoco.MjData(model)
+        mujoco.mj_resetDataKeyframe(model, data, 0)
+        mujoco.mj_step(model, data)
+        assert np.isfinite(data.qpos).all()

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lca.config.schema import ActorConfig
+from lca.learn.config import ActorConfig
 from lca.learn.exploration import noise_ceiling
 
 from .helpers import make_trainer, read_curve, smoke_cfg

@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lca.config.schema import CommandCurriculumConfig, RewardCurriculumConfig
 from lca.learn.command_curriculum import CommandCurriculum
 from lca.learn.reward_curriculum import RewardCurriculum
+from lca.task.config import CommandCurriculumConfig, RewardCurriculumConfig
 
 from .helpers import make_trainer, read_curve, smoke_cfg
 

@@ -10,7 +10,7 @@ import pytest
 import torch
 from omegaconf import OmegaConf
 
-from lca.config.schema import EvalCell
+from lca.evaluate.config import EvalCell
 from lca.evaluate.policy import final_checkpoint, load_policy, load_run_config
 from lca.evaluate.protocol import cell_config
 from lca.task.env import LocomotionEnv

@@ -27,7 +27,7 @@ from .helpers import (
     run_cli,
 )
 
-pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
+pytestmark = [pytest.mark.slow, pytest.mark.e2e]  # run.py end to end: see README
 
 RUN_NAMES = ["actor=lstm,logger=none,scale=smoke", "actor=mlp,logger=none,scale=smoke"]
 

@@ -13,7 +13,7 @@ from lca.evaluate.metrics import METRICS
 
 from .helpers import REPO, cell_units, run_python
 
-pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
+pytestmark = [pytest.mark.slow, pytest.mark.e2e]  # run.py end to end: see README
 
 SWEEP = [
     "-m",

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lca.config.schema import CommandConfig
 from lca.task.commands import VelocityCommand, gait_phase
+from lca.task.config import CommandConfig
 
 
 def test_gait_phase_left_and_right_half_a_period_apart():

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from lca.config import compose
-from lca.config.schema import RewardParams
+from lca.task.config import RewardParams
 from lca.task.rewards import REWARD_TERMS, RewardContext, compute_rewards
 from lca.task.state import RobotState
 

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from lca.config.schema import TerminationConfig
+from lca.task.config import TerminationConfig
 from lca.task.terminations import TERMINATIONS, fell, non_finite
 
 from .helpers import make_state

@@ -39,6 +39,7 @@ def test_registered_variants_compose_and_build(example_variants) -> None:
 
 
 @pytest.mark.slow
+@pytest.mark.e2e
 def test_variants_from_outside_run_train_evaluate_report(tmp_path) -> None:
     env = cli_env() | {
         "LCA_PLUGINS": "example_variants",
@@ -123,3 +124,25 @@ def test_a_stateful_term_is_reset_with_its_envs() -> None:
         assert term.count[[0, 1, 4]].tolist() == [3.0, 0.0, 0.0]
     finally:
         REWARD_TERMS.unregister("steps_alive")
+
+
+def test_a_term_reads_new_state_from_the_live_physics(example_variants) -> None:
+    import mujoco
+    import torch
+
+    from lca.task.env import LocomotionEnv
+
+    term = "+task.rewards.body_below={weight: -1.0, params: {body: torso_link, height: 5.0}}"
+    env = LocomotionEnv(compose(["scale=smoke", "terrain=flat", term]))
+    env.reset_all()
+    env.step(torch.zeros(env.num_envs, env.num_actions))
+    # the torso's height, from a plain MuJoCo forward pass of world 0's state
+    data = mujoco.MjData(env.sim.model)
+    data.qpos[:] = env.sim.qpos[0]
+    mujoco.mj_kinematics(env.sim.model, data)
+    torso = data.xpos[env.sim.body_id("torso_link"), 2]
+    assert 0.5 < torso < 1.5
+    got = env.episode_sums["body_below"][0] / env.dt  # weight -1: minus the term, once
+    assert got == pytest.approx(-(5.0 - torso), abs=0.05)  # xpos: the step's start
+    with pytest.raises(KeyError, match="no body 'tail'"):
+        env.sim.body_id("tail")

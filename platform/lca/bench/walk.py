@@ -27,7 +27,7 @@ import pandas as pd  # noqa: E402
 from lca.cli import split_option  # noqa: E402
 from lca.config import compose  # noqa: E402
 from lca.config.runtime import set_torch_threads  # noqa: E402
-from lca.config.schema import EvalCell  # noqa: E402
+from lca.evaluate.config import EvalCell  # noqa: E402
 from lca.evaluate.probe import TrainingProbe  # noqa: E402
 from lca.learn.train_cfg import build_train_cfg  # noqa: E402
 from lca.learn.trainer import Trainer  # noqa: E402

@@ -9,13 +9,11 @@ from lca.config.compose import (
     validate,
 )
 from lca.config.runtime import register_resolvers, resolve_device, set_torch_threads
-from lca.config.schema import LcaConfig
 
 register_resolvers()
 
 __all__ = [
     "ConfigError",
-    "LcaConfig",
     "compose",
     "conf_dir",
     "load_option",
@@ -24,3 +22,11 @@ __all__ = [
     "set_torch_threads",
     "validate",
 ]
+
+
+def __getattr__(name: str):
+    if name == "LcaConfig":  # assembled from the layers' groups on first use
+        from lca.config.schema import root
+
+        return root()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

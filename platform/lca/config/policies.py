@@ -15,7 +15,7 @@ from pathlib import Path
 from omegaconf import DictConfig, OmegaConf
 
 from lca.config.errors import ConfigValueError
-from lca.config.learn_schema import MATCH_KEYS, PolicyConfig
+from lca.config.schema import MATCH_KEYS, PolicyConfig
 from lca.paths import conf_dir
 
 

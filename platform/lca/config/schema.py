@@ -1,61 +1,78 @@
-"""Typed schema of every config group; registered in Hydra's ConfigStore as `lca_schema`.
+"""The root of the typed config, registered in Hydra's ConfigStore as `lca_schema`.
+
+Each layer owns its groups' dataclasses, next to its code (`lca.sim.config`,
+`lca.task.config`, `lca.learn.config`, `lca.evaluate.config`), and registers each with
+`@group("<name>")`. This module never imports those layers: `LcaConfig` is assembled from
+the registered groups the first time it is asked for, after the registries have loaded the
+built-in variants (which import every layer's config module) and any plugin.
 
 A typo in a key or a wrong type fails when Hydra composes. Value checks (ranges, sums) live
-in `check()` methods that `lca.config.validate` runs right after composition. Each stage's
-groups live in their own module (sim_schema, task_schema, ...); this one assembles the root.
+in `check()` methods that `lca.config.validate` runs right after composition.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, make_dataclass
+from functools import cache
 
 from hydra.core.config_store import ConfigStore
 
-from lca.config.errors import ConfigValueError  # noqa: F401 (re-exported)
-from lca.config.eval_schema import (  # noqa: F401 (re-exported)
-    EvalCell,
-    EvalConfig,
+from lca.config.errors import ConfigValueError, require  # noqa: F401 (re-exported)
+from lca.config.registry import load_plugins
+
+# the root's groups, in the order of conf/config.yaml's defaults list
+ORDER = (
+    "sim",
+    "robot",
+    "terrain",
+    "difficulty",
+    "task",
+    "perception",
+    "hardware",
+    "actor",
+    "encoder",
+    "curriculum",
+    "algo",
+    "eval",
+    "logger",
+    "scale",
 )
-from lca.config.hardware_schema import (  # noqa: F401 (re-exported)
-    HARDWARE_TASKS,
-    CameraConfig,
-    HardwareConfig,
-    HingedPlankConfig,
-    PerceptionConfig,
-    SoftMatConfig,
-    StairTaskConfig,
-)
-from lca.config.learn_schema import (  # noqa: F401 (re-exported)
-    ActorConfig,
-    AlgoConfig,
-    CurriculumConfig,
-    EncoderConfig,
-    LoggerConfig,
-    PolicyConfig,
-    ScaleConfig,
-)
-from lca.config.sim_schema import (  # noqa: F401 (re-exported)
-    ActuatorGroup,
-    DifficultyConfig,
-    RobotConfig,
-    SimConfig,
-    TerrainConfig,
-)
-from lca.config.task_schema import (  # noqa: F401 (re-exported)
-    CommandConfig,
-    CommandCurriculumConfig,
-    ObservationConfig,
-    RandomizationConfig,
-    ResetConfig,
-    RewardCurriculumConfig,
-    RewardParams,
-    TaskConfig,
-    TerminationConfig,
-)
+_GROUPS: dict[str, type] = {}
+
+
+def group(name: str):
+    """Class decorator: the dataclass of config group `name` (one per group)."""
+
+    def register(cls: type) -> type:
+        _GROUPS[name] = cls
+        return cls
+
+    return register
+
+
+MATCH_KEYS = {"curriculum": "curriculum.name", "actor": "actor.kind", "encoder": "encoder.kind"}
 
 
 @dataclass
-class LcaConfig:
+class PolicyConfig:
+    """The report's name for a run: set by a `conf/policy/*.yaml` option, or filled at
+    composition from the policy file whose `match` equals the run (lca.config.policies)."""
+
+    label: str = ""  # the table row, e.g. "Two-Stage MLP"; "" = not resolved yet
+    row: int = 100  # position of the row in tables (smaller first)
+    # which runs the label names: curriculum (name), actor and encoder (kinds); an absent key
+    # matches any value (the blind policy's actor never sees the encoder)
+    match: dict[str, str] = field(default_factory=dict)
+
+    def check(self) -> None:
+        unknown = sorted(set(self.match) - set(MATCH_KEYS))
+        require(
+            not unknown, "policy.match", f"unknown keys {unknown}; allowed: {sorted(MATCH_KEYS)}"
+        )
+
+
+@dataclass
+class RootFields:
     seed: int = 0
     device: str = "auto"  # torch device: auto = cuda when available, else cpu
     torch_threads: int = 0  # 0 = torch default
@@ -64,25 +81,34 @@ class LcaConfig:
     collect_threads: int = 0
     runs_root: str = "runs"  # run store: one folder per run, named by its overrides
     force: bool = False  # re-run even when the run directory holds a completed run
-    sim: SimConfig = field(default_factory=SimConfig)
-    robot: RobotConfig = field(default_factory=RobotConfig)
-    terrain: TerrainConfig = field(default_factory=TerrainConfig)
-    difficulty: DifficultyConfig = field(default_factory=DifficultyConfig)
-    task: TaskConfig = field(default_factory=TaskConfig)
-    perception: PerceptionConfig = field(default_factory=PerceptionConfig)
-    hardware: HardwareConfig = field(default_factory=HardwareConfig)
-    actor: ActorConfig = field(default_factory=ActorConfig)
-    encoder: EncoderConfig = field(default_factory=EncoderConfig)
-    curriculum: CurriculumConfig = field(default_factory=CurriculumConfig)
-    algo: AlgoConfig = field(default_factory=AlgoConfig)
-    eval: EvalConfig = field(default_factory=EvalConfig)
-    logger: LoggerConfig = field(default_factory=LoggerConfig)
-    scale: ScaleConfig = field(default_factory=ScaleConfig)
-    policy: PolicyConfig = field(default_factory=PolicyConfig)
+
+
+@cache
+def root() -> type:
+    """The root dataclass: the root's own fields, every registered group, then `policy`."""
+    load_plugins()
+    missing = [name for name in ORDER if name not in _GROUPS]
+    if missing:
+        raise RuntimeError(f"config groups {missing} were never registered (@group)")
+    names = [*ORDER, *(name for name in _GROUPS if name not in ORDER)]
+    fields = [(n, _GROUPS[n], field(default_factory=_GROUPS[n])) for n in names]
+    fields.append(("policy", PolicyConfig, field(default_factory=PolicyConfig)))
+    cls = make_dataclass("LcaConfig", fields, bases=(RootFields,))
+    cls.__module__ = __name__  # pickle finds it through this module's __getattr__
+    return cls
+
+
+def groups() -> dict[str, type]:
+    """{group name: its dataclass}, every built-in and plugin loaded."""
+    root()
+    return dict(_GROUPS)
 
 
 def register() -> None:
-    ConfigStore.instance().store(name="lca_schema", node=LcaConfig)
+    ConfigStore.instance().store(name="lca_schema", node=root())
 
 
-register()
+def __getattr__(name: str):
+    if name == "LcaConfig":  # built on first use (pickle finds it here too)
+        return root()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -18,7 +18,7 @@ import numpy as np
 import torch
 from omegaconf import DictConfig, OmegaConf
 
-from lca.config.schema import EvalCell
+from lca.evaluate.config import EvalCell
 from lca.evaluate.policy import new_policy
 from lca.evaluate.protocol import cell_config, round_seed, run_round
 from lca.task.env import LocomotionEnv

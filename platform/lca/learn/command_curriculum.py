@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-from lca.config.schema import CommandCurriculumConfig
+from lca.task.config import CommandCurriculumConfig
 
 
 class CommandCurriculum:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 
-from lca.config.schema import CurriculumConfig
+from lca.learn.config import CurriculumConfig
 
 
 def switch_iteration(cfg: CurriculumConfig, total_iterations: int) -> int:

@@ -14,7 +14,7 @@ import re
 
 import torch
 
-from lca.config.schema import ActorConfig
+from lca.learn.config import ActorConfig
 from lca.sim.robot import JOINT_GROUPS
 
 

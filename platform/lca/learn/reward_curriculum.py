@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from lca.config.schema import RewardCurriculumConfig
+from lca.task.config import RewardCurriculumConfig
 
 
 class RewardCurriculum:

@@ -102,9 +102,7 @@ class Trainer:
         with contextlib.redirect_stdout(io.StringIO()):  # rsl-rl prints the model summaries
             self.runner = OnPolicyRunner(self.env, train_cfg, log_dir=log_dir, device=self.device)
         self.alg = self.runner.alg
-        # provenance.json records the code state; rsl-rl's own git probe of its installed
-        # package only prints "Could not find git repository"
-        self.runner.logger.git_status_repos = []
+        self.runner.logger.git_status_repos = []  # provenance.json records the code state
         self.start = 0
         set_initial_stds(self.alg.get_policy(), cfg.actor, self.env.scene.joint_names)
         self.stats = EpisodeStats(self.env.num_envs, self.env.device)

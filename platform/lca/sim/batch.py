@@ -10,8 +10,8 @@ import mjbatch
 import mujoco
 import numpy as np
 
-from lca.config.schema import ResetConfig
 from lca.sim import robot as g1
+from lca.sim.config import ResetConfig
 from lca.sim.scene import Scene
 
 
@@ -40,6 +40,7 @@ class BatchedSim:
         self.env_tile = np.arange(num_envs) % len(centres)
         self.env_origin = centres[self.env_tile]
         self._friction = None
+        self._views: dict[str, np.ndarray] = {}
         self._body_mass = None
         self._nominal_friction = self.model.geom_friction[:, 0].copy()
         self._nominal_mass = self.model.body_mass.copy()
@@ -51,6 +52,22 @@ class BatchedSim:
 
     def sensor(self, name: str) -> np.ndarray:
         return self.batch.sensor(name)
+
+    def data(self, field: str) -> np.ndarray:
+        """A live (N, ...) view of an mjData field (`xpos`, `cvel`, `subtree_com`, ...). A
+        bound field is filled by every later step (kinematics: at the last substep's start);
+        the first call fills it with a forward pass, which leaves the state untouched."""
+        if field not in self._views:
+            self._views[field] = self.batch.bind(field)
+            self.batch.forward(None)
+        return self._views[field]
+
+    def body_id(self, name: str) -> int:
+        """The id of body `name`; a name the model lacks raises, naming it."""
+        found = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, name)
+        if found < 0:
+            raise KeyError(f"no body '{name}' in the scene")
+        return found
 
     def step(self, nstep: int = 1, ids: np.ndarray | None = None) -> None:
         self.batch.step(ids, nstep=nstep)

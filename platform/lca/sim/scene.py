@@ -9,8 +9,8 @@ import mujoco
 import numpy as np
 from omegaconf import DictConfig
 
-from lca.config.schema import RobotConfig, SimConfig
 from lca.sim import robot as g1
+from lca.sim.config import RobotConfig, SimConfig
 from lca.sim.terrain import Terrain, generate
 
 HFIELD_BASE_DEPTH = 0.5  # m of solid below the lowest terrain point

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from lca.config.registry import TILES
-from lca.config.schema import DifficultyConfig, TerrainConfig
+from lca.sim.config import DifficultyConfig, TerrainConfig
 
 
 @dataclass

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from lca.config.schema import CommandConfig
+from lca.task.config import CommandConfig
 
 
 class VelocityCommand:

@@ -259,6 +259,7 @@ class LocomotionEnv(VecEnv):
             torso_ids=self.torso_ids,
             terminated=terminated,
             params=self.task_cfg.reward_params,
+            sim=self.sim,
         )
 
     def _episode_log(self, ids: np.ndarray, fallen: np.ndarray, time_out: np.ndarray) -> dict:

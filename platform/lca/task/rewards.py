@@ -13,7 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from lca.config.registry import REWARD_TERMS
-from lca.config.schema import RewardParams
+from lca.sim.batch import BatchedSim
+from lca.task.config import RewardParams
 from lca.task.state import RobotState
 
 
@@ -33,6 +34,9 @@ class RewardContext:
     torso_ids: np.ndarray
     terminated: np.ndarray  # (N,) bool: fell or non-finite (time-outs excluded)
     params: RewardParams
+    # the live batched physics: a term that needs a quantity RobotState lacks reads it here
+    # (`sim.data("xpos")[:, sim.body_id("torso_link")]`, `sim.sensor(name)`), no edits elsewhere
+    sim: BatchedSim | None = None
 
     @property
     def contact(self) -> np.ndarray:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from lca.config.schema import TerminationConfig
+from lca.task.config import TerminationConfig
 from lca.task.state import RobotState
 
 

@@ -8,15 +8,17 @@ from omegaconf import MISSING
 
 from lca.config.errors import check_range, require
 from lca.config.registry import TILES
+from lca.config.schema import group
 
 
+@group("sim")
 @dataclass
 class SimConfig:
     timestep: float = 0.005  # 200 Hz physics
     decimation: int = 4  # 50 Hz policy
-    integrator: str = "implicitfast"
-    cone: str = "pyramidal"
-    iterations: int = 10  # bounded solver work per step
+    integrator: str = "implicitfast"  # implicit PD damping, cheaper than implicit
+    cone: str = "pyramidal"  # cheaper than elliptic at 10 iterations
+    iterations: int = 10  # bounded solver work per physics step
     ls_iterations: int = 5
     bvactive: bool = False  # MuJoCo's default (on) makes stepping ~3x slower
     num_threads: int = 0  # mjbatch worker threads; 0 = every logical CPU
@@ -39,12 +41,13 @@ class ActuatorGroup:
     effort_limit: float = MISSING  # N m
 
 
+@group("robot")
 @dataclass
 class RobotConfig:
     name: str = "g1"
     # PD gains from armature: kp = I w^2, kd = 2 zeta I w (w = 2 pi f); stiff yet stable at 200 Hz
     natural_frequency_hz: float = 10.0
-    damping_ratio: float = 2.0
+    damping_ratio: float = 2.0  # overdamped, as in mjlab's G1
     # Explicit gains (joint name regex -> N m/rad, N m s/rad) override the armature rule for
     # the joints they match, e.g. IsaacLab's G1 gains (conf/robot/g1_isaaclab.yaml).
     stiffness: dict[str, float] = field(default_factory=dict)
@@ -52,8 +55,9 @@ class RobotConfig:
     actuators: dict[str, ActuatorGroup] = field(default_factory=dict)
     home: dict[str, float] = field(default_factory=dict)  # joint name regex -> angle (rad)
     home_base_height: float = 0.0  # 0: computed so the feet rest on the ground
+    # primitives that touch terrain and task objects (not each other)
     collision_parts: list[str] = field(default_factory=lambda: ["feet", "legs", "torso", "arms"])
-    self_collision: bool = False
+    self_collision: bool = False  # robot-robot contacts off for speed
     foot_friction: float = 1.0
     # Sole contact spheres in the ankle-roll frame (toes, heels); the sole is at z = -0.035.
     foot_spheres: list[list[float]] = field(
@@ -64,13 +68,15 @@ class RobotConfig:
             [-0.05, -0.02, -0.025],
         ]
     )
-    foot_sphere_radius: float = 0.01
+    foot_sphere_radius: float = 0.01  # sphere bottoms sit on the sole plane z = -0.035
 
     def check(self) -> None:
-        for name, group in self.actuators.items():
+        for name, actuator in self.actuators.items():
             key = f"robot.actuators.{name}"
-            require(len(group.rotor_inertia) == len(group.gear_ratio), key, "stage counts differ")
-            require(group.effort_limit > 0, f"{key}.effort_limit", "must be > 0")
+            require(
+                len(actuator.rotor_inertia) == len(actuator.gear_ratio), key, "stage counts differ"
+            )
+            require(actuator.effort_limit > 0, f"{key}.effort_limit", "must be > 0")
         allowed = ("feet", "legs", "torso", "arms")
         for part in self.collision_parts:
             require(
@@ -83,6 +89,7 @@ class RobotConfig:
                 require(value >= 0, f"robot.{key}.{pattern}", f"must be >= 0, got {value}")
 
 
+@group("terrain")
 @dataclass
 class TerrainConfig:
     name: str = "mixed"
@@ -126,8 +133,11 @@ class TerrainConfig:
         require(self.num_steps >= 1, "terrain.num_steps", f"must be >= 1, got {self.num_steps}")
 
 
+@group("difficulty")
 @dataclass
 class DifficultyConfig:
+    """The paper's table "Environment parameters" (m); medium is in-distribution."""
+
     name: str = "medium"
     stairs_riser: list[float] = field(default_factory=lambda: [0.14, 0.18])  # m
     stairs_tread: float = 0.31  # m
@@ -140,3 +150,93 @@ class DifficultyConfig:
         require(self.stairs_tread > 0, "difficulty.stairs_tread", "must be > 0")
         check_range("difficulty.uneven_height", self.uneven_height)
         require(self.height_noise >= 0, "difficulty.height_noise", "must be >= 0")
+
+
+@dataclass
+class ResetConfig:
+    joint_pos_noise: float = 0.05  # rad, uniform around home
+    joint_vel_noise: float = 0.0
+    base_xy_noise: float = 0.1  # m, uniform around the tile centre
+    yaw_range: float = 3.14159  # rad; spawn heading uniform in [-yaw_range, yaw_range]
+
+
+@dataclass
+class CameraConfig:
+    body: str = MISSING
+    pos: list[float] = MISSING  # m, in the body frame
+    pitch_deg: float = 60.0  # optical axis below horizontal
+    yaw_deg: float = 0.0  # 180 looks backwards
+    fov_h_deg: float = 87.0  # Intel RealSense D435 depth field of view
+    fov_v_deg: float = 58.0
+    rays_h: int = 24  # ray grid subsampling the D435's 848 x 480 (CPU cost)
+    rays_w: int = 36
+    min_range: float = 0.1
+    max_range: float = 3.0
+    noise_k: float = 0.004  # depth noise sigma = k d^2 (stereo error grows with d^2)
+    invalid_fraction: float = 0.02  # pixels with no depth
+
+
+HARDWARE_TASKS = ("stair_ascent", "stair_descent", "hinged_ledge", "soft_ledge")
+
+
+@dataclass
+class StairTaskConfig:
+    steps: int = 3  # a short flight (paper)
+    riser: float = 0.18  # m, ~18 cm (paper)
+    landing: float = 0.20  # m, tread depth: small ~20 cm landings (paper)
+    skew_deg: float = 25.0  # stair edges rotated in the horizontal plane, ~25 deg (paper)
+
+
+@dataclass
+class HingedPlankConfig:
+    """The hinged ledge: a plank balanced on a pivot that tips under load."""
+
+    length: float = 1.2  # m
+    width: float = 0.6
+    thickness: float = 0.04
+    pivot_height: float = 0.10  # m, plank centre above the ground when level
+    tip_deg: float = 12.0  # hinge range: the plank tips this far either way
+    mass: float = 6.0  # kg
+    damping: float = 2.0  # N m s / rad
+    # m between the ledge wall and the plank's near end, so a tipping plank clears it
+    gap: float = 0.05
+
+
+@dataclass
+class SoftMatConfig:
+    """The soft ledge: a compliant gym mat (soft contact)."""
+
+    length: float = 1.2  # m
+    width: float = 1.0
+    thickness: float = 0.10
+    # time constant 4x MuJoCo's default, underdamped: it sinks under a foot
+    solref: list[float] = field(default_factory=lambda: [0.08, 0.7])
+    solimp: list[float] = field(default_factory=lambda: [0.3, 0.9, 0.06, 0.5, 2.0])
+
+
+@group("hardware")
+@dataclass
+class HardwareConfig:
+    """The paper's four hardware tasks, rebuilt in simulation (section Hardware Experiments)."""
+
+    name: str = "default"
+    tasks: list[str] = field(default_factory=lambda: list(HARDWARE_TASKS))
+    trials: int = 5  # per policy and task (paper)
+    command_x: float = 0.3  # m/s forward from a standing start (paper)
+    time_limit_s: float = 20.0
+    approach: float = 1.0  # m of flat ground (or platform) before the feature
+    goal_past: float = 0.6  # m past the feature's end that counts as completed
+    ledge_drop: float = 0.36  # m, elevation change of both ledges (paper)
+    resolution: float = 0.01  # m, heightfield of the static geometry
+    stairs: StairTaskConfig = field(default_factory=StairTaskConfig)
+    plank: HingedPlankConfig = field(default_factory=HingedPlankConfig)
+    mat: SoftMatConfig = field(default_factory=SoftMatConfig)
+
+    def check(self) -> None:
+        for task in self.tasks:
+            require(
+                task in HARDWARE_TASKS,
+                "hardware.tasks",
+                f"unknown '{task}'; allowed: {HARDWARE_TASKS}",
+            )
+        require(self.trials >= 1, "hardware.trials", "must be >= 1")

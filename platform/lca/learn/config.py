@@ -6,13 +6,15 @@ from dataclasses import dataclass, field
 
 from lca.config.errors import require
 from lca.config.registry import ACTORS, ENCODERS
+from lca.config.schema import group
 
 
+@group("actor")
 @dataclass
 class ActorConfig:
     name: str = "mlp"
     kind: str = "mlp"  # a registered actor kind (lca.learn.variants): mlp | lstm
-    hidden_dims: list[int] = field(default_factory=lambda: [512, 256, 128])
+    hidden_dims: list[int] = field(default_factory=lambda: [512, 256, 128])  # paper, ELU
     activation: str = "elu"
     rnn_hidden_dim: int = 256  # LSTM width before the MLP head (lstm only)
     init_noise_std: float = 1.0
@@ -47,26 +49,34 @@ class ActorConfig:
         require(self.noise_by in allowed, "actor.noise_by", f"allowed: {allowed}")
 
 
+@group("encoder")
 @dataclass
 class EncoderConfig:
     name: str = "cnn"
     kind: str = "cnn"  # a registered encoder kind (lca.learn.variants): cnn | mlp
+    # paper: CNN (3x3, stride 1) with hidden {256, 256}
     hidden_dims: list[int] = field(default_factory=lambda: [256, 256])
-    latent_dim: int = 32  # z_H
-    conv_channels: list[int] = field(default_factory=lambda: [8, 16])  # cnn only
+    latent_dim: int = 32  # z_H; the paper leaves d_H open
+    # two 3x3 stride-1 convolutions ahead of the {256, 256} head (cnn only)
+    conv_channels: list[int] = field(default_factory=lambda: [8, 16])
     kernel_size: int = 3
     stride: int = 1
-    pool: int = 0  # max-pool after each convolution (cnn only); 0: none (the paper's CNN)
+    # max-pool after each convolution (cnn only); 0: none, the paper's CNN. 2: 11x11 -> 5x5 ->
+    # 2x2, ~5x cheaper updates on CPU; tables label such rows "CNN (pooled)"
+    pool: int = 0
 
     def check(self) -> None:
         ENCODERS.check(self.kind, "encoder.kind")
         require(self.pool in (0, 2, 3), "encoder.pool", f"allowed: 0 (none), 2, 3; got {self.pool}")
 
 
+@group("curriculum")
 @dataclass
 class CurriculumConfig:
     name: str = "two"
-    perception_from: float = 0.5  # fraction of iterations after which the actor sees its map
+    # fraction of iterations after which the actor sees its map (paper: blind for the first
+    # half, then perception on)
+    perception_from: float = 0.5
 
     def check(self) -> None:
         require(
@@ -74,8 +84,11 @@ class CurriculumConfig:
         )
 
 
+@group("algo")
 @dataclass
 class AlgoConfig:
+    """rsl-rl-lib PPO with an asymmetric critic; legged-gym / IsaacLab defaults."""
+
     name: str = "ppo"
     num_steps_per_env: int = 24
     num_learning_epochs: int = 5
@@ -89,7 +102,7 @@ class AlgoConfig:
     max_grad_norm: float = 1.0
     schedule: str = "adaptive"
     desired_kl: float = 0.01
-    obs_normalization: bool = True
+    obs_normalization: bool = True  # proprioception only; heightmaps bypass the normaliser
     symmetry: bool = False  # rsl-rl symmetry_cfg: every mini-batch also holds its mirror image
     mirror_loss_coeff: float = 0.0  # > 0 adds rsl-rl's mirror loss (MLP actors only)
 
@@ -119,6 +132,7 @@ class AlgoConfig:
         )
 
 
+@group("logger")
 @dataclass
 class LoggerConfig:
     name: str = "tensorboard"  # tensorboard | wandb | none
@@ -130,6 +144,7 @@ class LoggerConfig:
         require(self.name in allowed, "logger.name", f"unknown '{self.name}'; allowed: {allowed}")
 
 
+@group("scale")
 @dataclass
 class ScaleConfig:
     name: str = "cpu"
@@ -141,24 +156,3 @@ class ScaleConfig:
         for key in ("max_iterations", "log_interval", "checkpoint_interval"):
             value = getattr(self, key)
             require(value >= 1, f"scale.{key}", f"must be >= 1, got {value}")
-
-
-MATCH_KEYS = {"curriculum": "curriculum.name", "actor": "actor.kind", "encoder": "encoder.kind"}
-
-
-@dataclass
-class PolicyConfig:
-    """The report's name for a run: set by a `conf/policy/*.yaml` option, or filled at
-    composition from the policy file whose `match` equals the run (lca.config.policies)."""
-
-    label: str = ""  # the table row, e.g. "Two-Stage MLP"; "" = not resolved yet
-    row: int = 100  # position of the row in tables (smaller first)
-    # which runs the label names: curriculum (name), actor and encoder (kinds); an absent key
-    # matches any value (the blind policy's actor never sees the encoder)
-    match: dict[str, str] = field(default_factory=dict)
-
-    def check(self) -> None:
-        unknown = sorted(set(self.match) - set(MATCH_KEYS))
-        require(
-            not unknown, "policy.match", f"unknown keys {unknown}; allowed: {sorted(MATCH_KEYS)}"
-        )

@@ -8,6 +8,7 @@ from omegaconf import MISSING
 
 from lca.config.errors import check_range, require
 from lca.config.registry import eval_terrain_names
+from lca.config.schema import group
 from lca.paths import conf_dir
 
 
@@ -22,18 +23,23 @@ class EvalCell:
     difficulty: str = MISSING  # medium | hard
 
 
+@group("eval")
 @dataclass
 class EvalConfig:
+    """The paper's protocol: U units x E episodes x T steps per cell, forward commands, the
+    difficulty's heightmap noise. The paper's sizes (500 x 3 x 1000) are set by scale=paper."""
+
     name: str = "default"
     units: int = 32  # simulated robots per cell (paper: 500)
     episodes: int = 2  # episodes per unit (paper: 3)
     steps: int = 500  # policy steps per episode (paper: 1000)
-    cells: list[EvalCell] = field(
+    cells: list[EvalCell] = field(  # stairs = half the tiles up, half down
         default_factory=lambda: [
             EvalCell(t, d) for t in ("stairs", "uneven") for d in ("medium", "hard")
         ]
     )
-    command_x: list[float] = field(default_factory=lambda: [0.3, 0.6])  # m/s forward
+    # m/s forward, inside the training range; lateral and yaw commands zero
+    command_x: list[float] = field(default_factory=lambda: [0.3, 0.6])
     seed: int = 12345
     bootstrap_resamples: int = 2000
     confidence: float = 0.95

@@ -10,14 +10,8 @@ from omegaconf import MISSING
 
 from lca.config.errors import check_range, require
 from lca.config.registry import OBS_TERMS, REWARD_TERMS
-
-
-@dataclass
-class ResetConfig:
-    joint_pos_noise: float = 0.05  # rad, uniform
-    joint_vel_noise: float = 0.0
-    base_xy_noise: float = 0.1  # m, uniform around the tile centre
-    yaw_range: float = 3.14159  # rad, uniform spawn heading
+from lca.config.schema import group
+from lca.sim.config import CameraConfig, ResetConfig
 
 
 @dataclass
@@ -37,40 +31,25 @@ class ObsTermConfig:
     clip: float | None = None  # |scaled value| bound; None: unbounded
 
 
-def _paper_proprioception() -> list[ObsTermConfig]:
-    return [
-        ObsTermConfig("joint_pos", 1.0, 0.01),
-        ObsTermConfig("joint_vel", 0.05, 1.5),
-        ObsTermConfig("base_ang_vel", 0.25, 0.2),
-        ObsTermConfig("projected_gravity", 1.0, 0.05),
-    ]
-
-
-def _paper_current() -> list[ObsTermConfig]:
-    return [
-        ObsTermConfig("velocity_commands", [2.0, 2.0, 0.25]),
-        ObsTermConfig("actions"),
-        ObsTermConfig("phase"),
-    ]
-
-
 @dataclass
 class ObservationConfig:
-    history: int = 5  # K proprioception frames, newest first
-    # the terms of each history frame, in order, and the current terms after the history
-    proprioception: list[ObsTermConfig] = field(default_factory=_paper_proprioception)
-    current: list[ObsTermConfig] = field(default_factory=_paper_current)
+    history: int = 5  # K: the paper leaves it open; 5 frames (0.1 s), newest first
+    # the terms of each history frame, in order, and the current terms after the history:
+    # declared in conf/task/<task>.yaml only
+    proprioception: list[ObsTermConfig] = MISSING
+    current: list[ObsTermConfig] = MISSING
     noise: bool = True  # actor observation noise on/off
-    height_dropout: float = 0.05  # fraction of actor heightmap cells dropped (set to the mean)
-    actor_grid: list[int] = field(default_factory=lambda: [11, 11])
-    actor_spacing: float = 0.1  # m: 11 x 11 cells over 1.0 m x 1.0 m
-    critic_grid: list[int] = field(default_factory=lambda: [16, 16])
-    critic_spacing: float = 0.1  # m: 16 x 16 cells over 1.5 m x 1.5 m
+    # the sparse map: this share of the actor's cells is dropped (set to the mean) per step
+    height_dropout: float = 0.05
+    actor_grid: list[int] = field(default_factory=lambda: [11, 11])  # paper
+    actor_spacing: float = 0.1  # m: 11 x 11 cells over 1.0 m x 1.0 m (paper)
+    critic_grid: list[int] = field(default_factory=lambda: [16, 16])  # paper
+    critic_spacing: float = 0.1  # m: 16 x 16 cells over 1.5 m x 1.5 m (paper)
 
 
 @dataclass
 class CommandConfig:
-    lin_vel_x: list[float] = field(default_factory=lambda: [-0.6, 0.6])  # m/s
+    lin_vel_x: list[float] = field(default_factory=lambda: [-0.6, 0.6])  # m/s; paper: up to 0.6
     lin_vel_y: list[float] = field(default_factory=lambda: [-0.3, 0.3])  # m/s
     ang_vel_z: list[float] = field(default_factory=lambda: [-0.5, 0.5])  # rad/s
     standing_fraction: float = 0.1  # share of commands that are exactly zero
@@ -172,12 +151,14 @@ class CommandCurriculumConfig:
         require(0 <= self.deadline <= 1, f"{key}.deadline", "must be in [0, 1]")
 
 
+@group("task")
 @dataclass
 class TaskConfig:
     name: str = "locomotion"
     num_envs: int = 256
-    episode_length_s: float = 20.0
-    action_scale: float = 0.25  # rad per unit action around the default pose
+    episode_length_s: float = 20.0  # 1000 policy steps at 50 Hz, the paper's episode
+    # joint target = default + action_scale * action, rad (legged-gym practice)
+    action_scale: float = 0.25
     # True: joint j's scale is action_scale * effort_limit_j / kp_j (mjlab's G1 rule), so a
     # unit action asks for the same fraction of each joint's torque
     action_scale_by_effort: bool = False
@@ -188,9 +169,12 @@ class TaskConfig:
     observations: ObservationConfig = field(default_factory=ObservationConfig)
     commands: CommandConfig = field(default_factory=CommandConfig)
     # term name -> weight, or {weight: w, params: {...}} (mjlab's form: the term is called as
-    # f(ctx, **params)); names are the registered reward terms (lca.task.rewards)
-    rewards: dict[str, Any] = field(default_factory=dict)
-    only_positive_rewards: bool = False  # clip the step's sum (but termination) at 0, always
+    # f(ctx, **params)); names are the registered reward terms (lca.task.rewards). Declared
+    # in conf/task/<task>.yaml only: the paper's table "Nominal reward terms"
+    rewards: dict[str, Any] = MISSING
+    # legged_gym's clip of the step's sum (but termination) at 0, for the whole run. Off: the
+    # paper optimises its table unclipped; the reward curriculum can clip as an early stage
+    only_positive_rewards: bool = False
     reward_curriculum: RewardCurriculumConfig = field(default_factory=RewardCurriculumConfig)
     command_curriculum: CommandCurriculumConfig = field(default_factory=CommandCurriculumConfig)
     reward_params: RewardParams = field(default_factory=RewardParams)
@@ -231,3 +215,26 @@ class TaskConfig:
                 key,
                 f"the weight must be a number, got {entry!r}",
             )
+
+
+@group("perception")
+@dataclass
+class PerceptionConfig:
+    """privileged (the training default): the exact terrain grid with the difficulty's noise
+    and dropout; deployment: depth cameras and the paper's filter."""
+
+    name: str = "privileged"
+    source: str = "privileged"  # privileged: exact grid + noise; deployment: cameras + filter
+    rate_hz: float = 30.0  # camera rate; the 50 Hz policy reads the latest map
+    outlier_gamma: float = 2.0  # cells with |g - mu| >= gamma sigma are set to mu
+    quantum: float = 0.05  # m, map quantisation (paper)
+    cameras: list[CameraConfig] = field(default_factory=list)
+
+    def check(self) -> None:
+        allowed = ("privileged", "deployment")
+        require(self.source in allowed, "perception.source", f"allowed: {allowed}")
+        require(
+            self.source == "privileged" or len(self.cameras) > 0,
+            "perception.cameras",
+            "the deployment pipeline needs at least one camera",
+        )

@@ -1,0 +1,66 @@
+"""The throughput benchmarks (`python -m lca.bench sim|env|train`) run end to end at toy
+sizes and report what they claim: rates from real stepping, ratios against their baseline
+measured in the same run, and a verdict that follows the target."""
+
+from __future__ import annotations
+
+import pytest
+
+from lca.bench import env, sim, train
+
+pytestmark = pytest.mark.slow  # steps the physics and trains: see README
+
+SMALL = ["scale=smoke", "terrain=flat"]
+
+
+def test_sim_bench_measures_both_loops(monkeypatch) -> None:
+    monkeypatch.setattr(sim, "NUM_ENVS", (8,))
+    monkeypatch.setattr(sim, "THREADS", (1, 2))
+    monkeypatch.setattr(sim, "REPEATS", 1)
+    monkeypatch.setattr(sim, "MIN_SECONDS", 0.05)
+    lines: list[str] = []
+    result = sim.run(SMALL, log=lines.append)
+    assert result["single_steps_per_s"] > 100  # a G1 steps far faster than 100 Hz here
+    assert [(r["num_envs"], r["threads"]) for r in result["batched"]] == [(8, 1), (8, 2)]
+    assert all(r["steps_per_s"] > 100 for r in result["batched"])
+    assert lines[0].startswith("single mj_step loop:")
+
+
+def test_sim_verdict_follows_the_target() -> None:
+    rows = [{"num_envs": 256, "threads": 2, "steps_per_s": 1700.0}]
+    assert "1.70x (meets)" in sim.table({"single_steps_per_s": 1000.0, "batched": rows})
+    rows[0]["steps_per_s"] = 1500.0
+    assert "1.50x (MISSES)" in sim.table({"single_steps_per_s": 1000.0, "batched": rows})
+
+
+def test_env_bench_measures_env_against_raw_physics(monkeypatch) -> None:
+    monkeypatch.setattr(env, "NUM_ENVS", (8,))
+    monkeypatch.setattr(env, "THREADS", (1,))
+    monkeypatch.setattr(env, "REPEATS", 1)
+    monkeypatch.setattr(env, "MIN_SECONDS", 0.05)
+    result = env.run(SMALL, log=None)
+    (row,) = result["batched"]
+    assert row["steps_per_s"] > 10 and row["raw_steps_per_s"] > 10
+    assert row["ratio"] == pytest.approx(row["steps_per_s"] / row["raw_steps_per_s"])
+    assert 0 < row["ratio"] < 1.5  # the task adds work on top of the same physics
+    assert result["max_rss_mb"] > 100
+
+
+def test_env_verdict_follows_the_target() -> None:
+    row = {"num_envs": 256, "threads": 2, "steps_per_s": 800.0, "raw_steps_per_s": 1000.0}
+    row |= {"ratio": 0.8, "memory_mb_per_env": 0.1}
+    assert "ratio >= 0.8: 0.80 (meets)" in env.table({"max_rss_mb": 900, "batched": [row]})
+    row["ratio"] = 0.79
+    assert "(MISSES)" in env.table({"max_rss_mb": 900, "batched": [row]})
+
+
+def test_train_bench_splits_an_iteration_and_measures_its_baseline(monkeypatch) -> None:
+    monkeypatch.setattr(train, "ITERATIONS", 2)
+    result = train.run([*SMALL, "curriculum=blind", "encoder=mlp"], log=None)
+    for r in (result, result["baseline"]):
+        assert r["iterations"] == 2
+        assert r["iteration_s"] == pytest.approx(r["collect_s"] + r["update_s"], rel=0.5)
+        assert 0 < r["update_fraction"] < 1
+    assert result["baseline"]["learning_epochs"] == 5  # rsl-rl's default, the baseline
+    text = train.table(result)
+    assert "target: update <= 25 % of an iteration" in text and "baseline" in text
