@@ -53,6 +53,7 @@ def test_the_check_sees_a_violation(tmp_path) -> None:
     assert stage_of(next(iter(lca_imports(bad)))) == "task"
 
 
+@pytest.mark.slow  # a subprocess
 def test_a_fresh_process_knows_every_built_in_variant() -> None:
     """Composition alone (no stage imported first) loads every registry's built-ins."""
     import json
