@@ -38,9 +38,14 @@ def test_every_project_policy_file_is_well_formed_and_distinct() -> None:
     assert set(policies) == {p.stem for p in (conf_dir() / "policy").glob("*.yaml")}
     labels = [p.label for p in policies.values()]
     assert len(set(labels)) == len(labels)
-    # each option composes to a config its own block fits
+    # each option selects the groups its own block matches
     for name, policy in policies.items():
-        assert compose([f"policy={name}"]).policy.label == policy.label
+        chosen = {}
+        for entry in OmegaConf.load(conf_dir() / "policy" / f"{name}.yaml").defaults:
+            ((key, value),) = OmegaConf.to_container(entry).items()
+            chosen[key.removeprefix("override /")] = value
+        assert {k: chosen[k] for k in policy.match} == dict(policy.match), name
+    assert compose(["policy=two_lstm_cnn"]).policy.label == "Two-Stage LSTM-CNN"
 
 
 def test_a_bad_match_key_fails_at_composition() -> None:

@@ -135,6 +135,7 @@ def test_cameras_see_the_pit_stairs(stairs_env: LocomotionEnv):
         assert m.max() - m.min() >= 0.1  # a 14-18 cm riser survives quantisation
 
 
+@pytest.mark.slow  # a multi-second rollout
 def test_map_only_changes_on_30hz_camera_frames(stairs_env: LocomotionEnv):
     env = stairs_env
     assert env.dt == pytest.approx(0.02) and env.perception_cfg.rate_hz == 30.0

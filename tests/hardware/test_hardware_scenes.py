@@ -351,6 +351,7 @@ def test_soft_mat_gives_much_more_than_rigid_ground(cfg):
 # ---- python -m lca.hardware.scenes -------------------------------------------------------
 
 
+@pytest.mark.slow  # a stage's command
 def test_scenes_command_writes_each_task_as_a_loadable_model(tmp_path, capsys) -> None:
     from lca.hardware import scenes
 

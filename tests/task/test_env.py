@@ -200,6 +200,7 @@ def test_non_finite_states_are_reset_and_counted(mixed_env):
     np.testing.assert_array_equal(critic_frames(obs)[ok, 1:], before[ok, :-1])
 
 
+@pytest.mark.slow  # a multi-second rollout
 def test_random_rollout_on_mixed_terrain_runs_clean(mixed_env):
     _, env = mixed_env
     n = env.num_envs
