@@ -1,6 +1,11 @@
-"""Shared, session-scoped configs and scenes: building a scene takes ~0.5-2 s."""
+"""Shared, session-scoped configs and scenes: building a scene takes ~0.5-2 s.
+
+LCA_TEST_REVERSE=1 runs the collected tests in reverse order: with `-p randomly` (shuffled),
+the check that no test depends on another having run first."""
 
 from __future__ import annotations
+
+import os
 
 import pytest
 from omegaconf import DictConfig
@@ -13,6 +18,11 @@ from lca.sim.scene import Scene, build_scene
 # gains (ankle kp 28.5) rely on the policy for balance, so the robot falls without one.
 STAND_OVERRIDES = ["terrain=flat", "scale=smoke", "robot.natural_frequency_hz=30"]
 MIXED_OVERRIDES = ["terrain=mixed", "scale=smoke"]
+
+
+def pytest_collection_modifyitems(config, items) -> None:
+    if os.environ.get("LCA_TEST_REVERSE") == "1":
+        items.reverse()
 
 
 @pytest.fixture(scope="session")
