@@ -59,6 +59,12 @@ def test_no_default_option_restates_the_dataclass(group: str, name: str) -> None
     assert restated(code_defaults()[group], option_values(group, name), group) == []
 
 
+def test_the_root_config_restates_no_default() -> None:
+    root = OmegaConf.to_container(OmegaConf.load(conf_dir() / "config.yaml"))
+    own = {k: v for k, v in root.items() if k not in ("defaults", "hydra")}
+    assert restated(code_defaults(), own, "config") == []
+
+
 def test_the_composed_defaults_are_the_dataclasses_plus_the_yaml_tables() -> None:
     expected = OmegaConf.structured(schema.root())
     for group, name in default_options():

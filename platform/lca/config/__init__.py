@@ -22,11 +22,3 @@ __all__ = [
     "set_torch_threads",
     "validate",
 ]
-
-
-def __getattr__(name: str):
-    if name == "LcaConfig":  # assembled from the layers' groups on first use
-        from lca.config.schema import root
-
-        return root()
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

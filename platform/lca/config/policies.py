@@ -10,6 +10,7 @@ empty label, and the report refuses it by name rather than pooling it into anoth
 from __future__ import annotations
 
 from collections.abc import Iterable
+from functools import cache
 from pathlib import Path
 
 from omegaconf import DictConfig, OmegaConf
@@ -27,8 +28,13 @@ def search_dirs(searchpath: Iterable[str] = ()) -> list[Path]:
 
 def known_policies(searchpath: Iterable[str] = ()) -> dict[str, PolicyConfig]:
     """{option name: its policy block} over every `policy/*.yaml` in the search folders."""
+    return dict(_read_policies(tuple(search_dirs(searchpath))))
+
+
+@cache  # every composition asks; the files are read once per set of folders
+def _read_policies(folders: tuple[Path, ...]) -> dict[str, PolicyConfig]:
     found = {}
-    for folder in search_dirs(searchpath):
+    for folder in folders:
         for path in sorted((folder / "policy").glob("*.yaml")):
             block = OmegaConf.load(path).get("policy")
             if block is None:
@@ -47,22 +53,25 @@ def run_choices(cfg: DictConfig) -> dict[str, str]:
 def matching_policy(cfg: DictConfig, searchpath: Iterable[str] = ()) -> PolicyConfig | None:
     """The policy whose match is the most specific one that fits the run; two equally
     specific matches are a config error naming both files."""
+    choices = run_choices(cfg)
     found = [
-        (len(p.match), name, p) for name, p in known_policies(searchpath).items() if fits(p, cfg)
+        (len(p.match), name, p)
+        for name, p in known_policies(searchpath).items()
+        if fits(p, choices)
     ]
     if not found:
         return None
     found.sort(key=lambda f: -f[0])
     if len(found) > 1 and found[0][0] == found[1][0] and found[0][2].label != found[1][2].label:
         raise ConfigValueError(
-            f"policy: {run_choices(cfg)} matches both conf/policy/{found[0][1]}.yaml and "
+            f"policy: {choices} matches both conf/policy/{found[0][1]}.yaml and "
             f"{found[1][1]}.yaml equally; make one `match` more specific"
         )
     return found[0][2]
 
 
-def fits(policy: DictConfig | PolicyConfig, cfg: DictConfig) -> bool:
-    choices = run_choices(cfg)
+def fits(policy: DictConfig | PolicyConfig, choices: dict[str, str]) -> bool:
+    """Whether the policy's `match` holds for a run's `run_choices`."""
     return all(choices[k] == v for k, v in policy.match.items())
 
 
@@ -70,7 +79,7 @@ def label_policy(cfg: DictConfig, searchpath: Iterable[str] = ()) -> None:
     """Set `cfg.policy` to the matching policy file's block. A block already there (from a
     `policy=` option or set by hand) stays if it still fits the run: `policy=two_mlp
     actor=lstm` is labelled as the LSTM it is. No match leaves the label empty."""
-    if cfg.policy.label and fits(cfg.policy, cfg):
+    if cfg.policy.label and fits(cfg.policy, run_choices(cfg)):
         return
     policy = matching_policy(cfg, searchpath) or PolicyConfig()
     cfg.policy = OmegaConf.structured(policy)

@@ -16,27 +16,12 @@ from dataclasses import dataclass, field, make_dataclass
 from functools import cache
 
 from hydra.core.config_store import ConfigStore
+from omegaconf import DictConfig, OmegaConf
 
 from lca.config.errors import ConfigValueError, require  # noqa: F401 (re-exported)
 from lca.config.registry import load_plugins
+from lca.paths import conf_dir
 
-# the root's groups, in the order of conf/config.yaml's defaults list
-ORDER = (
-    "sim",
-    "robot",
-    "terrain",
-    "difficulty",
-    "task",
-    "perception",
-    "hardware",
-    "actor",
-    "encoder",
-    "curriculum",
-    "algo",
-    "eval",
-    "logger",
-    "scale",
-)
 _GROUPS: dict[str, type] = {}
 
 
@@ -75,7 +60,7 @@ class PolicyConfig:
 class RootFields:
     seed: int = 0
     device: str = "auto"  # torch device: auto = cuda when available, else cpu
-    torch_threads: int = 0  # 0 = torch default
+    torch_threads: int = 0  # 0 = torch default; sweeps set 1 per process
     # torch threads while collecting rollouts (small policy inferences next to mjbatch's
     # threads); 0 = the same as for the update
     collect_threads: int = 0
@@ -83,25 +68,29 @@ class RootFields:
     force: bool = False  # re-run even when the run directory holds a completed run
 
 
+def default_groups() -> list[str]:
+    """The groups conf/config.yaml's defaults list chooses an option of (not `optional` ones)."""
+    names = []
+    for entry in OmegaConf.load(conf_dir() / "config.yaml").defaults:
+        if isinstance(entry, DictConfig):
+            names += [k for k in entry if not k.startswith("optional ")]
+    return names
+
+
 @cache
 def root() -> type:
     """The root dataclass: the root's own fields, every registered group, then `policy`."""
     load_plugins()
-    missing = [name for name in ORDER if name not in _GROUPS]
+    order = default_groups()  # the root's groups, as conf/config.yaml lists them
+    missing = [name for name in order if name not in _GROUPS]
     if missing:
         raise RuntimeError(f"config groups {missing} were never registered (@group)")
-    names = [*ORDER, *(name for name in _GROUPS if name not in ORDER)]
+    names = [*order, *(name for name in _GROUPS if name not in order)]
     fields = [(n, _GROUPS[n], field(default_factory=_GROUPS[n])) for n in names]
     fields.append(("policy", PolicyConfig, field(default_factory=PolicyConfig)))
     cls = make_dataclass("LcaConfig", fields, bases=(RootFields,))
     cls.__module__ = __name__  # pickle finds it through this module's __getattr__
     return cls
-
-
-def groups() -> dict[str, type]:
-    """{group name: its dataclass}, every built-in and plugin loaded."""
-    root()
-    return dict(_GROUPS)
 
 
 def register() -> None:
