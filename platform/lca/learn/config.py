@@ -105,6 +105,9 @@ class AlgoConfig:
     obs_normalization: bool = True  # proprioception only; heightmaps bypass the normaliser
     symmetry: bool = False  # rsl-rl symmetry_cfg: every mini-batch also holds its mirror image
     mirror_loss_coeff: float = 0.0  # > 0 adds rsl-rl's mirror loss (MLP actors only)
+    # a checkpoint whose actor and critic start this run (a warm start): its optimizer and
+    # iteration are not loaded, so every schedule starts at iteration 0. "": from scratch
+    init_from: str = ""
 
     def check(self) -> None:
         def positive(key: str) -> None:

@@ -31,6 +31,7 @@ def build_train_cfg(cfg: DictConfig, run_name: str) -> dict:
     algo = OmegaConf.to_container(cfg.algo, resolve=True)
     algo.pop("name")
     num_steps = algo.pop("num_steps_per_env")
+    algo.pop("init_from")  # read by the trainer, not by PPO
     obs_normalization = algo.pop("obs_normalization")
     symmetry_cfg = None
     mirror_loss = algo.pop("mirror_loss_coeff")

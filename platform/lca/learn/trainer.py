@@ -107,6 +107,8 @@ class Trainer:
         set_initial_stds(self.alg.get_policy(), cfg.actor, self.env.scene.joint_names)
         self.stats = EpisodeStats(self.env.num_envs, self.env.device)
         infos = self._load_newest_readable()
+        if infos is None and cfg.algo.init_from:
+            self._warm_start(Path(cfg.algo.init_from))
         self.rewards = RewardCurriculum(
             cfg.task.reward_curriculum, self.total, (infos or {}).get("penalty_scale")
         )
@@ -168,6 +170,16 @@ class Trainer:
             torch.cuda.set_rng_state_all(state["cuda_rng"])
         for name, hidden in state["hidden"].items():
             getattr(self.alg, name).rnn.hidden_state = hidden
+
+    def _warm_start(self, path: Path) -> None:
+        """Networks (and their observation normalisers and action std) from `path`; the
+        optimizer, iteration and every schedule start afresh."""
+        if not path.is_file():
+            raise FileNotFoundError(f"algo.init_from: no checkpoint at {path}")
+        self.runner.load(
+            str(path), load_cfg={"actor": True, "critic": True}, map_location=self.device
+        )
+        print(f"[lca] {self.run.path.name} starts from the networks of {path}")
 
     def _load_newest_readable(self) -> dict | None:
         """Load the newest checkpoint that reads (latest, then previous), saying what was
