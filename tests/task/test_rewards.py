@@ -417,8 +417,8 @@ def test_penalty_scale_multiplies_negative_contributions_only():
         params=cfg.task.reward_params,
     )
     weights = dict(cfg.task.rewards)
-    full, full_terms = compute_rewards(ctx, weights, 0.02)
-    scaled, terms = compute_rewards(ctx, weights, 0.02, penalty_scale=0.25)
+    full, full_terms = compute_rewards(ctx, weights, dt=0.02)
+    scaled, terms = compute_rewards(ctx, weights, dt=0.02, penalty_scale=0.25)
     for name, value in full_terms.items():
         expected = np.where(value < 0, 0.25 * value, value)
         np.testing.assert_allclose(terms[name], expected, err_msg=name)

@@ -165,12 +165,12 @@ class LocomotionEnv(VecEnv):
             ctx,
             self.weights,
             self.dt,
-            self.only_positive,
-            self.penalty_scale,
-            self.scaled_terms,
-            self.reward_term_params,
-            self.boosts,
-            self.reward_fns,
+            only_positive=self.only_positive,
+            penalty_scale=self.penalty_scale,
+            scaled_terms=self.scaled_terms,
+            params=self.reward_term_params,
+            boosts=self.boosts,
+            fns=self.reward_fns,
         )
         for name, value in terms.items():
             self.episode_sums[name] += value

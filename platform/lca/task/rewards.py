@@ -218,6 +218,7 @@ def compute_rewards(
     ctx: RewardContext,
     weights: dict[str, float],
     dt: float,
+    *,
     only_positive: bool = False,
     penalty_scale: float = 1.0,
     scaled_terms: frozenset[str] | None = None,
@@ -239,9 +240,7 @@ def compute_rewards(
     params, boosts = params or {}, boosts or {}
     fns = fns or {name: REWARD_TERMS[name] for name in weights}
     for name, weight in weights.items():
-        value = (
-            weight * boosts.get(name, 1.0) * REWARD_TERMS[name](ctx, **params.get(name, {})) * dt
-        )
+        value = weight * boosts.get(name, 1.0) * fns[name](ctx, **params.get(name, {})) * dt
         if penalty_scale != 1.0 and (scaled_terms is None or name in scaled_terms):
             value = np.where(value < 0, penalty_scale * value, value)
         terms[name] = value
