@@ -43,3 +43,22 @@ def test_warm_start_from_missing_file_names_the_key(tmp_path, smoke_scene) -> No
 def test_init_from_is_not_passed_to_ppo() -> None:
     algorithm = build_train_cfg(smoke_cfg("algo.init_from=x.pt"), "run")["algorithm"]
     assert "init_from" not in algorithm
+
+
+@pytest.mark.slow  # trains: see README
+def test_critic_warmup_trains_the_critic_only(tmp_path, smoke_scene) -> None:
+    cfg = smoke_cfg("scale.max_iterations=4", "algo.critic_warmup=2")
+    trainer = make_trainer(cfg, tmp_path / "run", smoke_scene)
+    actor0 = {k: v.clone() for k, v in trainer.alg.actor.state_dict().items()}
+    critic0 = {k: v.clone() for k, v in trainer.alg.critic.state_dict().items()}
+    trainer.train(hook=lambda trainer, it, row: it == 1)  # stopped after the warm-up
+    weight = "mlp.0.weight"
+    assert torch.equal(trainer.alg.actor.state_dict()[weight], actor0[weight])
+    assert not torch.equal(trainer.alg.critic.state_dict()[weight], critic0[weight])
+    rates = [float(r["learning_rate"]) for r in read_curve(tmp_path / "run" / "train_curve.csv")]
+    assert rates == [cfg.algo.learning_rate] * 2  # held: no KL to adapt it to
+
+    resumed = make_trainer(cfg, tmp_path / "run", smoke_scene)
+    resumed.train()
+    assert not torch.equal(resumed.alg.actor.state_dict()[weight], actor0[weight])
+    assert all(p.requires_grad for p in resumed.alg.actor.parameters())

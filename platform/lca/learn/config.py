@@ -108,6 +108,9 @@ class AlgoConfig:
     # a checkpoint whose actor and critic start this run (a warm start): its optimizer and
     # iteration are not loaded, so every schedule starts at iteration 0. "": from scratch
     init_from: str = ""
+    # iterations at the start that train the critic only (the actor frozen, the learning rate
+    # fixed): a warm start's critic first learns the new run's returns. 0: none
+    critic_warmup: int = 0
 
     def check(self) -> None:
         def positive(key: str) -> None:
@@ -120,6 +123,7 @@ class AlgoConfig:
 
         for key in ("learning_rate", "clip_param", "max_grad_norm", "desired_kl"):
             positive(key)
+        require(self.critic_warmup >= 0, "algo.critic_warmup", "must be >= 0")
         for key in ("num_steps_per_env", "num_learning_epochs", "num_mini_batches"):
             at_least_one(key)
         for key in ("entropy_coef", "value_loss_coef", "mirror_loss_coeff"):

@@ -171,6 +171,20 @@ class Trainer:
         for name, hidden in state["hidden"].items():
             getattr(self.alg, name).rnn.hidden_state = hidden
 
+    def _freeze_actor(self, frozen: bool) -> None:
+        """Critic warm-up: the actor's parameters out of the update and the learning rate
+        held (no KL to adapt it to); at the end the configured rate is set again."""
+        actor = self.alg.actor
+        was_frozen = not next(actor.parameters()).requires_grad
+        if frozen == was_frozen:
+            return
+        actor.requires_grad_(not frozen)
+        self.alg.schedule = "fixed" if frozen else self.cfg.algo.schedule
+        if not frozen:
+            self.alg.learning_rate = float(self.cfg.algo.learning_rate)
+            for group in self.alg.optimizer.param_groups:
+                group["lr"] = self.alg.learning_rate
+
     def _warm_start(self, path: Path) -> None:
         """Networks (and their observation normalisers and action std) from `path`; the
         optimizer, iteration and every schedule start afresh."""
@@ -333,6 +347,7 @@ class Trainer:
                 alg.compute_returns(obs)
             torch.set_num_threads(update_threads)
             t1 = time.perf_counter()
+            self._freeze_actor(it < cfg.algo.critic_warmup)
             losses = alg.update()
             t2 = time.perf_counter()
             self.runner.current_learning_iteration = it
