@@ -32,14 +32,20 @@ def test_until_stops_a_probed_run_that_is_complete(tmp_path):
     probes = pd.read_csv(run / "probe_evals.csv")
     assert list(probes["iteration"]) == [0, 1, 2]  # every iteration probed (eval_every_s=0)
     assert set(probes["paper_objective"]) == {1}  # smoke: no curriculum, no clipping
+    assert probes["still_cm_s"].notna().all()  # the zero-command probe ran each time
     assert (run / "COMPLETE").is_file() and (tmp_path / "walk.png").stat().st_size > 0
     assert (run / "exported" / "policy.onnx").is_file()
     assert out["env_steps"] == int(curve["env_steps"].iloc[-1])
 
 
 def test_walking_needs_the_paper_objective():
-    row = {"success": 100.0, "track_cm_s": 10.0, "penalty_scale": 1.0}
+    row = {"success": 100.0, "track_cm_s": 10.0, "still_cm_s": 3.0, "penalty_scale": 1.0}
     assert walk.walks({**row, "paper_objective": 1})
     assert not walk.walks({**row, "paper_objective": 0})  # clipped or penalties scaled
     assert not walk.walks({**row, "paper_objective": 1, "track_cm_s": 25.0})
     assert not walk.walks({**row, "paper_objective": 1, "success": 80.0})
+    # a forward walker that ignores the command: it walks on when told to stand
+    assert not walk.walks({**row, "paper_objective": 1, "still_cm_s": 40.0})
+    assert not walk.walks(
+        {k: v for k, v in row.items() if k != "still_cm_s"} | {"paper_objective": 1}
+    )

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import csv
+from pathlib import Path
 
 import pytest
 import torch
@@ -85,3 +86,12 @@ def test_probe_is_repeatable(tmp_path, smoke_scene):
     first, second = probe.evaluate(actor), probe.evaluate(actor)
     first.pop("eval_s"), second.pop("eval_s")
     assert first == second
+
+
+def test_probe_command_override_sets_the_commands():
+    cfg = smoke_cfg()
+    cell = EvalCell("flat", "medium")
+    still = TrainingProbe(cfg, Path("unused.csv"), cell, 2, 5, build_train_cfg(cfg, "p"), [0, 0])
+    assert list(still.env.task_cfg.commands.lin_vel_x) == [0.0, 0.0]
+    forward = TrainingProbe(cfg, Path("unused.csv"), cell, 2, 5, build_train_cfg(cfg, "p"))
+    assert list(forward.env.task_cfg.commands.lin_vel_x) == list(cfg.eval.command_x)

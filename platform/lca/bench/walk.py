@@ -5,15 +5,17 @@
 
 Every `eval_every_s` of training wall-clock the current policy is evaluated in-process with
 the paper's protocol on a flat cell (forward commands 0.3-0.6 m/s, 1000-step episodes,
-observation noise, no randomisation); that time is not counted. The policy *walks* at the
-first evaluation with success >= 90 % and tracking error <= 20 cm/s while the objective is
-the paper's (the reward curriculum, if any, has finished). Reports time_to_walk_s,
+observation noise, no randomisation), and on a zero command (16 units, 5 s); that time is not
+counted. The policy *walks* at the first evaluation with success >= 90 %, tracking error
+<= 20 cm/s and a base speed <= 20 cm/s when told to stand, while the objective is the paper's
+(the reward curriculum, if any, has finished). Reports time_to_walk_s,
 steps_to_walk, steps/s, writes the curve figure reports/bench/walk.png and the run directory
 (a complete run: config, provenance, curve, checkpoints, exported policy).
 """
 
 from __future__ import annotations
 
+import math
 import shutil
 from collections.abc import Callable
 from pathlib import Path
@@ -42,6 +44,10 @@ REPORTS = reports_dir()
 FLAT_CELL = EvalCell("flat", "medium")
 SUCCESS_MIN = 90.0  # %
 TRACK_MAX = 20.0  # cm/s
+# a forward-only probe passes a policy that walks forward whatever it is told (every walker
+# of reports/learning.md did): it must also stand still when the command is zero
+STILL_MAX = 20.0  # cm/s of base speed under a zero command
+STILL_UNITS, STILL_STEPS = 16, 250
 OPTIONS = {
     "cap_s": 3 * 3600.0,
     "eval_every_s": 240.0,
@@ -67,6 +73,7 @@ def walks(row: dict) -> bool:
     return (
         row["success"] >= SUCCESS_MIN
         and row["track_cm_s"] <= TRACK_MAX
+        and row.get("still_cm_s", math.nan) <= STILL_MAX
         and bool(row.get("paper_objective", row["penalty_scale"] >= 1.0))
     )
 
@@ -95,6 +102,15 @@ def run(args: list[str], log: Callable[[str], None] | None = print) -> dict:
         cfg.eval.steps,
         build_train_cfg(cfg, run.path.name),
     )
+    still = TrainingProbe(
+        cfg,
+        run.path / "probe_evals.csv",
+        FLAT_CELL,
+        min(STILL_UNITS, cfg.eval.units),
+        min(STILL_STEPS, cfg.eval.steps),
+        build_train_cfg(cfg, run.path.name),
+        command_x=[0.0, 0.0],
+    )
     trainer = Trainer(cfg, run)
     state = {"next": 0.0, "walked": None}
     for row in TrainingProbe.read(probe.out):  # a resumed benchmark keeps its earlier evaluations
@@ -109,6 +125,9 @@ def run(args: list[str], log: Callable[[str], None] | None = print) -> dict:
             return False
         state["next"] = wall + opts["eval_every_s"]
         result = probe.evaluate(trainer.alg.get_policy())
+        standing = still.evaluate(trainer.alg.get_policy())
+        result["still_cm_s"] = standing["track_cm_s"]
+        result["eval_s"] += standing["eval_s"]
         entry = {
             "iteration": it,
             "env_steps": row["env_steps"],
@@ -124,6 +143,7 @@ def run(args: list[str], log: Callable[[str], None] | None = print) -> dict:
             log(
                 f"[walk] {wall / 60:6.1f} min {row['env_steps'] / 1e6:6.2f} M steps | success "
                 f"{result['success']:5.1f} % | track {result['track_cm_s']:5.1f} cm/s | "
+                f"still {result['still_cm_s']:5.1f} cm/s | "
                 f"penalties x{row['penalty_scale']:.2f} | eval {result['eval_s']:.0f} s"
             )
         if walks(entry) and state["walked"] is None:
@@ -154,7 +174,11 @@ def summarise(run: RunDir, overrides: list[str], opts: dict, walked: dict | None
         "train_s": train_s,
         "env_steps": int(curve["env_steps"].iloc[-1]),
         "steps_per_s": float(curve["env_steps"].iloc[-1] / train_s),
-        "criteria": {"success_min": SUCCESS_MIN, "track_max_cm_s": TRACK_MAX},
+        "criteria": {
+            "success_min": SUCCESS_MIN,
+            "track_max_cm_s": TRACK_MAX,
+            "still_max_cm_s": STILL_MAX,
+        },
         "probe": {
             "units": int(cfg.eval.units),
             "steps": int(cfg.eval.steps),
@@ -173,7 +197,10 @@ def plot(evals: pd.DataFrame, out: Path) -> None:
         (axes[0], "success", SUCCESS_MIN, "success (%)"),
         (axes[1], "track_cm_s", TRACK_MAX, "tracking error (cm/s)"),
     ):
-        ax.plot(minutes, evals[col], marker="o", lw=1.5)
+        ax.plot(minutes, evals[col], marker="o", lw=1.5, label="forward 0.3-0.6 m/s")
+        if col == "track_cm_s" and "still_cm_s" in evals:
+            ax.plot(minutes, evals["still_cm_s"], marker="s", lw=1, label="zero command")
+            ax.legend(fontsize=8)
         ax.axhline(limit, color="grey", ls="--", lw=1)
         ax.set_xlabel("training wall-clock (min, 2 CPU cores)")
         ax.set_title(label, fontsize=10)
@@ -202,11 +229,13 @@ def table(r: dict) -> str:
     lines = [
         f"walked: {r['walked']}  time_to_walk_s: {r['time_to_walk_s']}  "
         f"steps_to_walk: {r['steps_to_walk']}  steps/s: {r['steps_per_s']:,.0f}",
-        f"{'min':>6} {'M steps':>8} {'success %':>9} {'track cm/s':>10} {'penalties':>9}",
+        f"{'min':>6} {'M steps':>8} {'success %':>9} {'track cm/s':>10} {'still cm/s':>10} "
+        f"{'penalties':>9}",
     ]
     for e in r["evals"]:
         lines.append(
             f"{e['train_wall_s'] / 60:6.1f} {e['env_steps'] / 1e6:8.2f} {e['success']:9.1f} "
-            f"{e['track_cm_s']:10.1f} {e['penalty_scale']:9.2f}"
+            f"{e['track_cm_s']:10.1f} {e.get('still_cm_s', math.nan):10.1f} "
+            f"{e['penalty_scale']:9.2f}"
         )
     return "\n".join(lines)

@@ -31,6 +31,7 @@ PROBE_FIELDS = (
     "paper_objective",
     "success",
     "track_cm_s",
+    "still_cm_s",
     "contacts_per_step",
     "mean_steps",
     "eval_s",
@@ -39,11 +40,21 @@ PROBE_FIELDS = (
 
 class TrainingProbe:
     def __init__(
-        self, cfg: DictConfig, out: Path, cell: EvalCell, units: int, steps: int, train_cfg: dict
+        self,
+        cfg: DictConfig,
+        out: Path,
+        cell: EvalCell,
+        units: int,
+        steps: int,
+        train_cfg: dict,
+        command_x: list[float] | None = None,
     ):
-        """`train_cfg`: the rsl-rl runner config of the training (the networks to copy into)."""
+        """`train_cfg`: the rsl-rl runner config of the training (the networks to copy into);
+        `command_x`: forward commands (m/s) instead of the protocol's `eval.command_x`."""
         cfg = copy.deepcopy(cfg)
         cfg.eval.units, cfg.eval.steps = int(units), int(steps)
+        if command_x is not None:
+            cfg.eval.command_x = list(command_x)
         self.cell = OmegaConf.structured(cell)
         self.env = LocomotionEnv(cell_config(cfg, self.cell))
         self.env.set_perception(False)
