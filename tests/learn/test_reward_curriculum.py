@@ -7,9 +7,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from lca.config import ConfigError
 from lca.learn.command_curriculum import CommandCurriculum
 from lca.learn.reward_curriculum import RewardCurriculum
-from lca.task.config import CommandCurriculumConfig, RewardCurriculumConfig
+from lca.task.commands import VelocityCommand
+from lca.task.config import (
+    CommandConfig,
+    CommandCurriculumConfig,
+    CommandRangesConfig,
+    RewardCurriculumConfig,
+)
 
 from .helpers import make_trainer, read_curve, smoke_cfg
 
@@ -100,6 +107,42 @@ def test_command_floor_falls_linearly_to_zero_at_the_deadline():
     np.testing.assert_allclose(floors[:10], 0.3 * (1 - np.arange(10) / 10))
     assert floors[10:] == [0.0] * 10
     assert CommandCurriculum(CommandCurriculumConfig(), 20).floor(0) == 0.0
+
+
+def test_command_ranges_widen_linearly_to_the_configured_ones():
+    start = CommandRangesConfig(lin_vel_x=[0.3, 0.6], lin_vel_y=[0.0, 0.0], standing_fraction=0)
+    cfg = CommandCurriculumConfig(enabled=True, min_speed=0.0, deadline=0.5, widen_from=start)
+    target = CommandConfig()  # x in [-0.6, 0.6], y in [-0.3, 0.3], 10 % standing
+    c = CommandCurriculum(cfg, total_iterations=20)
+    assert c.ranges(0, target) == {
+        "lin_vel_x": [0.3, 0.6],
+        "lin_vel_y": [0.0, 0.0],
+        "standing_fraction": 0.0,
+    }
+    half = c.ranges(5, target)
+    np.testing.assert_allclose(half["lin_vel_x"], [-0.15, 0.6])
+    np.testing.assert_allclose(half["lin_vel_y"], [-0.15, 0.15])
+    assert half["standing_fraction"] == pytest.approx(0.05)
+    assert "ang_vel_z" not in half  # not widened: the configured range throughout
+    assert c.ranges(10, target) == {} and c.ranges(19, target) == {}
+
+
+def test_commands_are_drawn_from_the_curriculum_ranges():
+    commands = VelocityCommand(CommandConfig(), 4000, 0.02, np.random.default_rng(0))
+    commands.ranges = {"lin_vel_x": [0.3, 0.6], "lin_vel_y": [0.0, 0.0], "standing_fraction": 0}
+    commands.resample(np.arange(4000))
+    u = commands.value
+    assert u[:, 0].min() >= 0.3 and u[:, 0].max() <= 0.6 and not u[:, 1].any()
+    assert np.abs(u[:, 2]).max() > 0.4  # yaw: still the configured +-0.5 rad/s
+    commands.ranges = {}
+    commands.resample(np.arange(4000))
+    assert commands.value[:, 0].min() < -0.5 and commands.standing.mean() > 0.05
+
+
+def test_widen_from_rejects_a_reversed_range():
+    bad = CommandCurriculumConfig(widen_from=CommandRangesConfig(lin_vel_x=[0.6, 0.3]))
+    with pytest.raises(ConfigError, match="widen_from.lin_vel_x"):
+        bad.check()
 
 
 def test_tracking_gate_steps_up_only_while_the_robot_tracks():

@@ -57,6 +57,7 @@ CURVE_FIELDS = (
     "kl",
     "penalty_scale",
     "command_floor",
+    "command_x_low",
     "tracking_progress",
     "falls",
     "nonfinite",
@@ -311,6 +312,7 @@ class Trainer:
             self.rewards.update(it, float(length) / env.max_episode_length, float(progress))
             env.set_reward_shaping(*self.rewards.shaping)
             env.commands.min_speed = self.commands.floor(it)
+            env.commands.ranges = self.commands.ranges(it, cfg.task.commands)
             ceiling = noise_ceiling(cfg.actor, it, self.total, self.rewards.progress)
             apply_ceiling(actor, ceiling)
             actor.kl_values = []
@@ -381,6 +383,9 @@ class Trainer:
                 "kl": float(np.mean(kl)) if kl else math.nan,
                 "penalty_scale": self.rewards.scale,
                 "command_floor": env.commands.min_speed,
+                "command_x_low": env.commands.ranges.get("lin_vel_x", cfg.task.commands.lin_vel_x)[
+                    0
+                ],
                 "falls": int(ends[1]),
                 "nonfinite": int(ends[2]),
                 "nonfinite_actions": int(ends[3]),

@@ -18,6 +18,7 @@ class VelocityCommand:
         self.value = np.zeros((num_envs, 3))
         self.time_left = np.zeros(num_envs)
         self.min_speed = 0.0  # the command curriculum's floor on |u_xy| (0: off)
+        self.ranges: dict = {}  # the command curriculum's ranges, in place of the config's
 
     @property
     def standing(self) -> np.ndarray:
@@ -27,20 +28,20 @@ class VelocityCommand:
         n = len(ids)
         if n == 0:
             return
-        c = self.cfg
+        c = self.ranges
         value = np.stack(
             [
-                self.rng.uniform(*c.lin_vel_x, n),
-                self.rng.uniform(*c.lin_vel_y, n),
-                self.rng.uniform(*c.ang_vel_z, n),
+                self.rng.uniform(*c.get("lin_vel_x", self.cfg.lin_vel_x), n),
+                self.rng.uniform(*c.get("lin_vel_y", self.cfg.lin_vel_y), n),
+                self.rng.uniform(*c.get("ang_vel_z", self.cfg.ang_vel_z), n),
             ],
             axis=1,
         )
         if self.min_speed > 0:
             value[:, :2] = _at_least(value[:, :2], self.min_speed)
-        value[self.rng.random(n) < c.standing_fraction] = 0.0
+        value[self.rng.random(n) < c.get("standing_fraction", self.cfg.standing_fraction)] = 0.0
         self.value[ids] = value
-        self.time_left[ids] = c.resample_time_s
+        self.time_left[ids] = self.cfg.resample_time_s
 
     def update(self) -> None:
         self.time_left -= self.dt

@@ -136,19 +136,47 @@ class RewardCurriculumConfig:
 
 
 @dataclass
+class CommandRangesConfig:
+    """Command ranges the curriculum starts from; a field left None is the configured one."""
+
+    lin_vel_x: list[float] | None = None  # m/s, [low, high]
+    lin_vel_y: list[float] | None = None  # m/s
+    ang_vel_z: list[float] | None = None  # rad/s
+    standing_fraction: float | None = None
+
+
+@dataclass
 class CommandCurriculumConfig:
     """Early commands walk: planar commands slower than a floor are scaled up to it (their
-    direction kept). The floor falls linearly from `min_speed` to 0 at `deadline` x
-    max_iterations, from where commands are the configured distribution."""
+    direction kept), and the command ranges widen from `widen_from` to the configured ones.
+    Both end linearly at `deadline` x max_iterations, from where commands are the configured
+    distribution."""
 
     enabled: bool = False
     min_speed: float = 0.3  # m/s, the floor at the first iteration
     deadline: float = 0.6  # fraction of max_iterations where the floor reaches 0
+    # the ranges at the first iteration (e.g. lin_vel_x: [0.3, 0.6], lin_vel_y: [0, 0]: forward
+    # only, so that a gait that walks forward is also one that follows its commands)
+    widen_from: CommandRangesConfig = field(default_factory=CommandRangesConfig)
 
     def check(self) -> None:
         key = "task.command_curriculum"
         require(self.min_speed >= 0, f"{key}.min_speed", "must be >= 0")
         require(0 <= self.deadline <= 1, f"{key}.deadline", "must be in [0, 1]")
+        for name in ("lin_vel_x", "lin_vel_y", "ang_vel_z"):
+            bounds = getattr(self.widen_from, name)
+            if bounds is not None:
+                require(
+                    len(bounds) == 2 and bounds[0] <= bounds[1],
+                    f"{key}.widen_from.{name}",
+                    f"need [low, high] with low <= high, got {list(bounds)}",
+                )
+        fraction = self.widen_from.standing_fraction
+        require(
+            fraction is None or 0 <= fraction <= 1,
+            f"{key}.widen_from.standing_fraction",
+            "must be in [0, 1]",
+        )
 
 
 @group("task")
