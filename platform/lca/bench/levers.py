@@ -24,26 +24,36 @@ LEVERS: dict[str, tuple[str, list[str]]] = {
     "recipe": ("the scale=cpu defaults", []),
     "before": (
         "the defaults before the recipe: one action scale 0.25, always only_positive, "
-        "no reward curriculum, no symmetry",
+        "no reward curriculum",
         [
             "task.action_scale_by_effort=false",
             "task.only_positive_rewards=true",
             "task.reward_curriculum.enabled=false",
-            "algo.symmetry=false",
         ],
     ),
     "no_curriculum": ("paper penalties from the start", ["task.reward_curriculum.enabled=false"]),
-    "only_positive_stage": (
-        "legged_gym's clipping while the curriculum runs",
-        ["task.reward_curriculum.only_positive=true"],
+    "no_clipping_stage": (
+        "no clipping of the step sum while the curriculum runs",
+        ["task.reward_curriculum.only_positive=false"],
     ),
     "isaaclab_gains": (
         "IsaacLab's G1 gains and one action scale 0.5",
         ["robot=g1_isaaclab", "task.action_scale_by_effort=false", "task.action_scale=0.5"],
     ),
     "one_action_scale": ("one action scale 0.25", ["task.action_scale_by_effort=false"]),
+    "forward_first": (
+        "commands forward only (0.3-0.6 m/s), widening to the full range by 60 %",
+        [
+            "task.command_curriculum.enabled=true",
+            "task.command_curriculum.min_speed=0",
+            "task.command_curriculum.widen_from.lin_vel_x=[0.3,0.6]",
+            "task.command_curriculum.widen_from.lin_vel_y=[0,0]",
+            "task.command_curriculum.widen_from.ang_vel_z=[0,0]",
+            "task.command_curriculum.widen_from.standing_fraction=0",
+        ],
+    ),
     "init_noise_0.5": ("initial action std 0.5", ["actor.init_noise_std=0.5"]),
-    "no_symmetry": ("no mirror augmentation", ["algo.symmetry=false"]),
+    "symmetry": ("mirror augmentation", ["algo.symmetry=true"]),
     "fixed_lr": ("fixed learning rate 3e-4", ["algo.schedule=fixed", "algo.learning_rate=3e-4"]),
     "envs_512x12": (
         "512 envs x 12 steps",
