@@ -6,8 +6,10 @@ Kept: config.yaml, provenance.json, train_cfg.json, train_curve.csv, the in-trai
 evaluations, summary.csv and results.parquet (when evaluated), exported/ (ONNX +
 TorchScript) and the final checkpoint without its optimizer state (evaluation and export
 need only the networks).
-`--resumable` ships `checkpoints/latest.pt` whole instead, so an unfinished training can be
-resumed by a later session (`cp -r dest runs/...` and re-run the same command).
+`--resumable` ships `checkpoints/latest.pt` instead, so an unfinished training can be
+resumed by a later session (`cp -r dest runs/...` and re-run the same command): networks
+only by default (the resumed run continues from that iteration with a fresh optimizer and
+environment), whole with `--exact` (bit for bit, about 4x larger).
 """
 
 from __future__ import annotations
@@ -42,7 +44,7 @@ def slim_checkpoint(src: Path, dest: Path) -> None:
     torch.save(state, dest)
 
 
-def ship(run_dir: Path, dest: Path, resumable: bool = False) -> list[Path]:
+def ship(run_dir: Path, dest: Path, resumable: bool = False, exact: bool = False) -> list[Path]:
     run_dir, dest = Path(run_dir), Path(dest)
     if not (run_dir / "config.yaml").exists():
         raise FileNotFoundError(f"{run_dir} has no config.yaml: not a run directory")
@@ -54,8 +56,10 @@ def ship(run_dir: Path, dest: Path, resumable: bool = False) -> list[Path]:
     if (run_dir / "exported").exists():
         shutil.copytree(run_dir / "exported", dest / "exported")
     checkpoints = run_dir / "checkpoints"
-    if resumable:
+    if resumable and exact:
         shutil.copy2(checkpoints / "latest.pt", _mkdir(dest / "checkpoints") / "latest.pt")
+    elif resumable:
+        slim_checkpoint(checkpoints / "latest.pt", dest / "checkpoints" / "latest.pt")
     else:
         finals = sorted(checkpoints.glob("final_*.pt"))
         if not finals:
@@ -74,8 +78,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("run_dir", type=Path)
     parser.add_argument("dest", type=Path)
     parser.add_argument("--resumable", action="store_true")
+    parser.add_argument("--exact", action="store_true", help="with --resumable: latest.pt whole")
     args = parser.parse_args(argv)
-    for path in ship(args.run_dir, args.dest, args.resumable):
+    if args.exact and not args.resumable:
+        parser.error("--exact needs --resumable")
+    for path in ship(args.run_dir, args.dest, args.resumable, args.exact):
         print(f"{path.stat().st_size / 1e6:7.2f} MB  {path}")
     return 0
 

@@ -204,7 +204,11 @@ class Trainer:
         for name in candidates:
             path = self.run.checkpoints / name
             try:
-                infos = self.runner.load(str(path), map_location=self.device)
+                # a shipped checkpoint holds the networks only: its optimizer starts afresh
+                saved = torch.load(path, map_location=self.device, weights_only=False)
+                parts = {"actor": True, "critic": True, "iteration": True}
+                parts["optimizer"] = "optimizer_state_dict" in saved
+                infos = self.runner.load(str(path), load_cfg=parts, map_location=self.device)
             except Exception as error:  # a truncated or corrupt file
                 reason = str(error).splitlines()[0][:200]
                 print(f"[lca] skipping unreadable checkpoint {path}: {reason}")
