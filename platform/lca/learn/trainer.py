@@ -159,9 +159,9 @@ class Trainer:
             "hidden": hidden,
         }
 
-    def _restore_loop_state(self, path: Path) -> None:
-        state = torch.load(path, map_location=self.device, weights_only=False).get(LOOP_STATE)
-        if state is None:  # a checkpoint from before exact resume: networks only
+    def _restore_loop_state(self, saved: dict, path: Path) -> None:
+        state = saved.get(LOOP_STATE)
+        if state is None:  # a shipped checkpoint, or one from before exact resume
             print(f"[lca] {path.name} holds no loop state: the environment starts afresh")
             return
         restore_env_state(self.env, state["env"])
@@ -208,20 +208,21 @@ class Trainer:
                 saved = torch.load(path, map_location=self.device, weights_only=False)
                 parts = {"actor": True, "critic": True, "iteration": True}
                 parts["optimizer"] = "optimizer_state_dict" in saved
-                infos = self.runner.load(str(path), load_cfg=parts, map_location=self.device)
+                self.alg.load(saved, parts, strict=True)
             except Exception as error:  # a truncated or corrupt file
                 reason = str(error).splitlines()[0][:200]
                 print(f"[lca] skipping unreadable checkpoint {path}: {reason}")
                 errors.append(f"{path}: {reason}")
                 continue
             # rsl-rl stores the index of the last finished iteration
+            self.runner.current_learning_iteration = int(saved["iter"])
             self.start = self.runner.current_learning_iteration + 1
-            self._restore_loop_state(path)
+            self._restore_loop_state(saved, path)
             print(
                 f"[lca] resuming {self.run.path.name} at iteration {self.start}/{self.total}"
                 f" (from {name})"
             )
-            return infos or {}
+            return saved.get("infos") or {}
         if errors:
             raise RuntimeError(
                 "no readable checkpoint to resume from: "
