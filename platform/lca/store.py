@@ -16,6 +16,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from importlib import metadata
 from pathlib import Path
 
@@ -32,12 +33,25 @@ FAILED = "FAILED"
 KEEP_ON_FORCE = (".hydra", LOCK)  # Hydra writes .hydra/ before the job starts
 
 
-def atomic_write(path: Path, text: str) -> None:
+def write_atomically(path: Path, write: Callable[[str], object], suffix: str = "") -> Path:
+    """`write(tmp)` into a uniquely named temporary file beside `path` (ending in `suffix`,
+    for writers that read the format from the name), then rename it to `path`: the file
+    appears complete or not at all, and a failed write leaves nothing behind."""
+    path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
-    with os.fdopen(fd, "w") as f:
-        f.write(text)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=suffix)
+    os.close(fd)
+    try:
+        write(tmp)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
     os.replace(tmp, path)
+    return path
+
+
+def atomic_write(path: Path, text: str) -> None:
+    write_atomically(path, lambda tmp: Path(tmp).write_text(text))
 
 
 def git_state(repo: Path) -> dict:

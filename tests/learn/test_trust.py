@@ -8,13 +8,14 @@ import os
 import signal
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 import torch
 
 from lca.learn.trainer import CURVE_FIELDS
-from lca.store import RunDir, RunLockedError
+from lca.store import RunDir, RunLockedError, atomic_write, write_atomically
 
 from .helpers import make_trainer, read_curve, smoke_cfg
 
@@ -169,3 +170,18 @@ def test_checkpoint_temporaries_are_unique_and_cleaned(tmp_path, smoke_scene):
     trainer.train()
     names = [p.name for p in trainer.run.checkpoints.iterdir()]
     assert not [n for n in names if n.startswith(".") or n.endswith(".tmp")], names
+
+
+def test_a_failed_atomic_write_keeps_the_old_file_and_leaves_nothing(tmp_path):
+    target = tmp_path / "summary.csv"
+    atomic_write(target, "old")
+
+    def broken(tmp):
+        Path(tmp).write_text("half")
+        raise OSError("disk full")
+
+    with pytest.raises(OSError, match="disk full"):
+        write_atomically(target, broken)
+    assert target.read_text() == "old" and sorted(tmp_path.iterdir()) == [target]
+    write_atomically(target, lambda tmp: Path(tmp).write_text("new"), suffix=".csv")
+    assert target.read_text() == "new" and sorted(tmp_path.iterdir()) == [target]

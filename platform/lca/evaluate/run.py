@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import pandas as pd
@@ -12,7 +10,7 @@ from lca.evaluate.media import make_media
 from lca.evaluate.metrics import summarize
 from lca.evaluate.policy import load_run_config
 from lca.evaluate.protocol import evaluate_run
-from lca.store import RunDir, atomic_write
+from lca.store import RunDir, atomic_write, write_atomically
 
 
 def evaluate_and_write(
@@ -22,10 +20,9 @@ def evaluate_and_write(
     with RunDir(run_dir).lock():
         episodes = evaluate_run(run_dir, cfg, log=log)
         episodes.insert(0, "run", Path(run_dir).name)
-        fd, tmp = tempfile.mkstemp(dir=run_dir, prefix=".results.parquet.")
-        os.close(fd)
-        episodes.to_parquet(tmp, index=False)
-        os.replace(tmp, Path(run_dir) / "results.parquet")
+        write_atomically(
+            Path(run_dir) / "results.parquet", lambda tmp: episodes.to_parquet(tmp, index=False)
+        )
         ev = cfg.eval
         summary = summarize(episodes, ev.bootstrap_resamples, ev.confidence, ev.seed)
         atomic_write(Path(run_dir) / "summary.csv", summary.to_csv(index=False))

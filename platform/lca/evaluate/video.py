@@ -5,13 +5,14 @@ imageio) where that binary cannot run.
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
 import imageio.v3 as iio
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
+
+from lca.store import write_atomically
 
 COMMAND, MEASURED = (250, 204, 21), (56, 189, 248)  # yellow, cyan
 HISTORY_S = 3.0  # s of forward velocity in the strip chart
@@ -88,17 +89,13 @@ def write_clip(path: Path, frames: list[np.ndarray], fps: float) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     if path.suffix.lower() == ".gif":
         return write_gif(path, frames, fps)
-    tmp = path.with_name(f".{path.stem}.tmp{path.suffix}")
     try:
-        _encode(tmp, frames, fps)
+        return write_atomically(path, lambda tmp: _encode(tmp, frames, fps), path.suffix)
     except (ImportError, RuntimeError, OSError):  # no encoder binary here: a GIF instead
-        tmp.unlink(missing_ok=True)
         return write_gif(path.with_suffix(".gif"), frames, fps)
-    os.replace(tmp, path)
-    return path
 
 
-def _encode(path: Path, frames: list[np.ndarray], fps: float) -> None:
+def _encode(path: str, frames: list[np.ndarray], fps: float) -> None:
     import imageio_ffmpeg  # ships its own ffmpeg binary
 
     height, width = frames[0].shape[:2]
@@ -122,18 +119,12 @@ def _encode(path: Path, frames: list[np.ndarray], fps: float) -> None:
 
 
 def write_gif(path: Path, frames: list[np.ndarray], fps: float) -> Path:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.stem}.tmp.gif")
-    iio.imwrite(tmp, np.stack(frames), extension=".gif", duration=1000.0 / fps, loop=0)
-    os.replace(tmp, path)
-    return path
+    stack = np.stack(frames)
+    return write_atomically(
+        path,
+        lambda tmp: iio.imwrite(tmp, stack, extension=".gif", duration=1000.0 / fps, loop=0),
+    )
 
 
 def write_png(path: Path, frame: np.ndarray) -> Path:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.stem}.tmp.png")
-    iio.imwrite(tmp, frame, extension=".png")
-    os.replace(tmp, path)
-    return path
+    return write_atomically(path, lambda tmp: iio.imwrite(tmp, frame, extension=".png"))

@@ -9,13 +9,13 @@ copied alone.
 
 from __future__ import annotations
 
-import os
-import tempfile
 import warnings
 from pathlib import Path
 
 import torch
 from torch import nn
+
+from lca.store import write_atomically
 
 ONNX_OPSET = 17
 
@@ -28,16 +28,10 @@ def _dynamic_axes(module: nn.Module) -> dict[str, dict[int, str]]:
 
 
 def _write_atomically(path: Path, write) -> Path:
-    """`write(tmp)` into a unique temporary file beside `path`, then rename it to `path`."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
-    os.close(fd)
+    """`write(tmp)`, then renamed to `path` (lca.store), without the exporters' notices."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the exporters' deprecation notices
-        write(tmp)
-    os.replace(tmp, path)
-    return path
+        return write_atomically(path, write)
 
 
 def export_onnx(actor, path: Path) -> Path:

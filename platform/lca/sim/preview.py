@@ -7,7 +7,6 @@ riser or block heights); right, a rendered close-up of the robot on the first ti
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +18,7 @@ from omegaconf import DictConfig
 
 from lca.sim import render
 from lca.sim.terrain import Terrain, Tile
+from lca.store import write_atomically
 
 MAP_PIXELS = 800  # height-map samples per side at most
 
@@ -83,9 +83,4 @@ def write_preview(
     right.set_axis_off()
     if title:
         fig.suptitle(title)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")
-    fig.savefig(tmp, format="png")
-    os.replace(tmp, path)
-    return path
+    return write_atomically(path, lambda tmp: fig.savefig(tmp, format="png"))
