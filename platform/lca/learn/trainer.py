@@ -12,8 +12,6 @@ import contextlib
 import csv
 import io
 import math
-import os
-import tempfile
 import time
 from pathlib import Path
 
@@ -24,6 +22,7 @@ from rsl_rl.runners import OnPolicyRunner
 
 from lca.config.runtime import resolve_device
 from lca.learn import curriculum
+from lca.learn.checkpoints import LATEST, Checkpoints
 from lca.learn.command_curriculum import CommandCurriculum
 from lca.learn.episode_stats import EpisodeStats
 from lca.learn.exploration import apply_ceiling, noise_ceiling, set_initial_stds
@@ -31,13 +30,10 @@ from lca.learn.export import export_jit, export_onnx
 from lca.learn.reward_curriculum import RewardCurriculum
 from lca.learn.train_cfg import build_train_cfg
 from lca.learn.variants import actor_spec
-from lca.store import RunDir
+from lca.store import RunDir, write_atomically
 from lca.task.env import LocomotionEnv
-from lca.task.env_state import env_state, restore_env_state
 from lca.testhook import exit_point
 
-LATEST, PREVIOUS = "latest.pt", "previous.pt"
-LOOP_STATE = "lca_loop_state"  # env, episode statistics, RNG and recurrent states
 CURVE_FIELDS = (
     "iteration",
     "env_steps",
@@ -67,12 +63,6 @@ BROKEN_STREAK = 3  # iterations whose every episode ends non-finite before a run
 MOVING = 0.2  # m/s: commands at least this fast count towards the tracking progress
 
 
-def _clone(hidden):
-    if hidden is None:
-        return None
-    return tuple(h.clone() for h in hidden) if isinstance(hidden, tuple) else hidden.clone()
-
-
 def _number(text: str):
     try:
         return float(text)
@@ -85,7 +75,7 @@ def _fmt_eta(seconds: float) -> str:
     return f"{seconds // 3600:d}:{seconds % 3600 // 60:02d}:{seconds % 60:02d}"
 
 
-class Trainer:
+class Trainer(Checkpoints):
     def __init__(self, cfg: DictConfig, run_dir: RunDir, env: LocomotionEnv | None = None):
         self.cfg = cfg
         self.run = run_dir
@@ -119,59 +109,6 @@ class Trainer:
     def perception_on(self, iteration: int) -> bool:
         return curriculum.perception_on(self.cfg.curriculum, iteration, self.total)
 
-    def save(self, name: str, iteration: int, upload: bool = False) -> Path:
-        """Write checkpoints/<name> atomically (a uniquely named temporary file, then a
-        rename). `latest.pt`'s previous version is kept as `previous.pt`, the fallback of a
-        resume. `upload` registers the final path with the logger (wandb)."""
-        self.run.checkpoints.mkdir(parents=True, exist_ok=True)
-        self.runner.current_learning_iteration = iteration
-        saved = self.alg.save()
-        saved["iter"] = iteration
-        saved["infos"] = {
-            "stage": curriculum.stage_name(self.cfg.curriculum, iteration, self.total),
-            "penalty_scale": self.rewards.scale,
-        }
-        saved[LOOP_STATE] = self._loop_state()
-        path = self.run.checkpoints / name
-        fd, tmp = tempfile.mkstemp(dir=self.run.checkpoints, prefix=f".{name}.")
-        os.close(fd)
-        torch.save(saved, tmp)
-        if name == LATEST and path.exists():
-            os.replace(path, self.run.checkpoints / PREVIOUS)
-        os.replace(tmp, path)
-        if upload:
-            self.runner.logger.save_model(str(path), iteration)
-        return path
-
-    def _loop_state(self) -> dict:
-        """What the loop carries across an iteration boundary besides the networks, so a
-        resumed run continues exactly as the uninterrupted one would."""
-        hidden = {}
-        for name in ("actor", "critic"):
-            model = getattr(self.alg, name)
-            if model.is_recurrent:
-                hidden[name] = _clone(model.rnn.hidden_state)
-        return {
-            "env": env_state(self.env),
-            "stats": self.stats.state_dict(),
-            "torch_rng": torch.get_rng_state(),
-            "cuda_rng": torch.cuda.get_rng_state_all() if torch.cuda.is_available() else None,
-            "hidden": hidden,
-        }
-
-    def _restore_loop_state(self, saved: dict, path: Path) -> None:
-        state = saved.get(LOOP_STATE)
-        if state is None:  # a shipped checkpoint, or one from before exact resume
-            print(f"[lca] {path.name} holds no loop state: the environment starts afresh")
-            return
-        restore_env_state(self.env, state["env"])
-        self.stats.load_state_dict(state["stats"])
-        torch.set_rng_state(state["torch_rng"].cpu())
-        if state["cuda_rng"] is not None and torch.cuda.is_available():
-            torch.cuda.set_rng_state_all(state["cuda_rng"])
-        for name, hidden in state["hidden"].items():
-            getattr(self.alg, name).rnn.hidden_state = hidden
-
     def _freeze_actor(self, frozen: bool) -> None:
         """Critic warm-up: the actor's parameters out of the update and the learning rate
         held (no KL to adapt it to); at the end the configured rate is set again."""
@@ -185,51 +122,6 @@ class Trainer:
             self.alg.learning_rate = float(self.cfg.algo.learning_rate)
             for group in self.alg.optimizer.param_groups:
                 group["lr"] = self.alg.learning_rate
-
-    def _warm_start(self, path: Path) -> None:
-        """Networks (and their observation normalisers and action std) from `path`; the
-        optimizer, iteration and every schedule start afresh."""
-        if not path.is_file():
-            raise FileNotFoundError(f"algo.init_from: no checkpoint at {path}")
-        self.runner.load(
-            str(path), load_cfg={"actor": True, "critic": True}, map_location=self.device
-        )
-        print(f"[lca] {self.run.path.name} starts from the networks of {path}")
-
-    def _load_newest_readable(self) -> dict | None:
-        """Load the newest checkpoint that reads (latest, then previous), saying what was
-        skipped and why; None when there is none. Raises naming the files if none reads."""
-        candidates = [p for p in (LATEST, PREVIOUS) if (self.run.checkpoints / p).exists()]
-        errors = []
-        for name in candidates:
-            path = self.run.checkpoints / name
-            try:
-                # a shipped checkpoint holds the networks only: its optimizer starts afresh
-                saved = torch.load(path, map_location=self.device, weights_only=False)
-                parts = {"actor": True, "critic": True, "iteration": True}
-                parts["optimizer"] = "optimizer_state_dict" in saved
-                self.alg.load(saved, parts, strict=True)
-            except Exception as error:  # a truncated or corrupt file
-                reason = str(error).splitlines()[0][:200]
-                print(f"[lca] skipping unreadable checkpoint {path}: {reason}")
-                errors.append(f"{path}: {reason}")
-                continue
-            # rsl-rl stores the index of the last finished iteration
-            self.runner.current_learning_iteration = int(saved["iter"])
-            self.start = self.runner.current_learning_iteration + 1
-            self._restore_loop_state(saved, path)
-            print(
-                f"[lca] resuming {self.run.path.name} at iteration {self.start}/{self.total}"
-                f" (from {name})"
-            )
-            return saved.get("infos") or {}
-        if errors:
-            raise RuntimeError(
-                "no readable checkpoint to resume from: "
-                + "; ".join(errors)
-                + f". Delete {self.run.checkpoints} to start this run afresh (or force=true)."
-            )
-        return None
 
     def _curve_rows_before(self, iteration: int) -> list[dict]:
         """Curve rows of a resumed run up to its checkpoint (later rows are re-done)."""
@@ -258,17 +150,13 @@ class Trainer:
         return streak
 
     def _rewrite_curve(self, rows: list[dict]) -> None:
-        self.run.path.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=self.run.path, prefix=f".{self.run.curve.name}.")
-        try:
-            with os.fdopen(fd, "w", newline="") as f:
+        def write(tmp: str) -> None:
+            with open(tmp, "w", newline="") as f:
                 writer = csv.DictWriter(f, fieldnames=CURVE_FIELDS, extrasaction="ignore")
                 writer.writeheader()
                 writer.writerows(rows)
-            os.replace(tmp, self.run.curve)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+
+        write_atomically(self.run.curve, write)
 
     def train(self, hook=None) -> dict:
         """Train to `scale.max_iterations`. `hook(trainer, iteration, row)`, if given, runs
@@ -373,6 +261,7 @@ class Trainer:
             done_its = it + 1 - self.start
             elapsed = time.perf_counter() - t_start - paused
             kl = getattr(actor, "kl_values", [])
+            x_range = env.commands.ranges.get("lin_vel_x", cfg.task.commands.lin_vel_x)
             row = {
                 "iteration": it,
                 "env_steps": (it + 1) * num_steps * env.num_envs,
@@ -388,9 +277,7 @@ class Trainer:
                 "kl": float(np.mean(kl)) if kl else math.nan,
                 "penalty_scale": self.rewards.scale,
                 "command_floor": env.commands.min_speed,
-                "command_x_low": env.commands.ranges.get("lin_vel_x", cfg.task.commands.lin_vel_x)[
-                    0
-                ],
+                "command_x_low": x_range[0],
                 "falls": int(ends[1]),
                 "nonfinite": int(ends[2]),
                 "nonfinite_actions": int(ends[3]),
