@@ -8,8 +8,9 @@ TorchScript) and the final checkpoint without its optimizer state (evaluation an
 need only the networks).
 `--resumable` ships `checkpoints/latest.pt` instead, so an unfinished training can be
 resumed by a later session (`cp -r dest runs/...` and re-run the same command): networks
-only by default (the resumed run continues from that iteration with a fresh optimizer and
-environment), whole with `--exact` (bit for bit, about 4x larger).
+only by default (the resumed run continues from that iteration with a fresh Adam at the run's
+adapted learning rate and a fresh environment, which perturbs a fragile gait for a while),
+whole with `--exact` (bit for bit, about 4x larger).
 """
 
 from __future__ import annotations
@@ -38,6 +39,9 @@ def slim_checkpoint(src: Path, dest: Path) -> None:
     """`src` without the optimizer state and the training loop's state (env, RNG): what
     evaluation and export need."""
     state = torch.load(src, map_location="cpu", weights_only=False)
+    optimizer = state.get("optimizer_state_dict")
+    if optimizer:  # the adapted rate: a resume from this file restarts Adam at it
+        state.setdefault("infos", {})["learning_rate"] = optimizer["param_groups"][0]["lr"]
     for key in DROPPED_KEYS:
         state.pop(key, None)
     dest.parent.mkdir(parents=True, exist_ok=True)

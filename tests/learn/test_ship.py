@@ -33,8 +33,14 @@ def test_resumable_ship_is_networks_only_and_resumes_at_its_iteration(
     whole = run / "checkpoints" / "latest.pt"
     assert latest.stat().st_size < whole.stat().st_size / 2
 
+    rate = torch.load(run / "checkpoints" / "latest.pt", weights_only=False)[
+        "optimizer_state_dict"
+    ]["param_groups"][0]["lr"]
+    assert saved["infos"]["learning_rate"] == rate
+
     resumed = make_trainer(cfg, tmp_path / "shipped", smoke_scene)
     assert resumed.start == 3
+    assert resumed.alg.learning_rate == rate  # the run's adapted rate, not the configured one
     weight = "mlp.0.weight"
     torch.testing.assert_close(
         resumed.alg.actor.state_dict()[weight], saved["actor_state_dict"][weight]

@@ -108,6 +108,11 @@ class Checkpoints:
                 print(f"[lca] skipping unreadable checkpoint {path}: {reason}")
                 errors.append(f"{path}: {reason}")
                 continue
+            rate = (saved.get("infos") or {}).get("learning_rate")
+            if not parts["optimizer"] and rate is not None:  # a fresh Adam at the run's rate
+                self.alg.learning_rate = float(rate)
+                for group in self.alg.optimizer.param_groups:
+                    group["lr"] = self.alg.learning_rate
             # rsl-rl stores the index of the last finished iteration
             self.runner.current_learning_iteration = int(saved["iter"])
             self.start = self.runner.current_learning_iteration + 1
