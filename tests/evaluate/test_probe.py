@@ -91,7 +91,7 @@ def test_probe_is_repeatable(tmp_path, smoke_scene):
 def test_probe_command_override_sets_the_commands():
     cfg = smoke_cfg()
     cell = EvalCell("flat", "medium")
-    still = TrainingProbe(cfg, Path("unused.csv"), cell, 2, 5, build_train_cfg(cfg, "p"), [0, 0])
+    still = TrainingProbe(cfg, None, cell, 2, 5, build_train_cfg(cfg, "p"), [0, 0])
     assert list(still.env.task_cfg.commands.lin_vel_x) == [0.0, 0.0]
     forward = TrainingProbe(cfg, Path("unused.csv"), cell, 2, 5, build_train_cfg(cfg, "p"))
     assert list(forward.env.task_cfg.commands.lin_vel_x) == list(cfg.eval.command_x)

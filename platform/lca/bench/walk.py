@@ -93,22 +93,17 @@ def run(args: list[str], log: Callable[[str], None] | None = print) -> dict:
     run.path.mkdir(parents=True, exist_ok=True)
     run.write_provenance(cfg, overrides, {"bench": "walk"})
     set_torch_threads(int(cfg.torch_threads))
-    # the probe's networks are built before the trainer's, as always: the trainer seeds torch
-    probe = TrainingProbe(
+    # the probes' networks are built before the trainer's, as always: the trainer seeds torch
+    train_cfg = build_train_cfg(cfg, run.path.name)
+    out = run.path / "probe_evals.csv"
+    probe = TrainingProbe(cfg, out, FLAT_CELL, cfg.eval.units, cfg.eval.steps, train_cfg)
+    still = TrainingProbe(  # evaluates only: its figure goes into the forward probe's row
         cfg,
-        run.path / "probe_evals.csv",
-        FLAT_CELL,
-        cfg.eval.units,
-        cfg.eval.steps,
-        build_train_cfg(cfg, run.path.name),
-    )
-    still = TrainingProbe(
-        cfg,
-        run.path / "probe_evals.csv",
+        None,
         FLAT_CELL,
         min(STILL_UNITS, cfg.eval.units),
         min(STILL_STEPS, cfg.eval.steps),
-        build_train_cfg(cfg, run.path.name),
+        train_cfg,
         command_x=[0.0, 0.0],
     )
     trainer = Trainer(cfg, run)

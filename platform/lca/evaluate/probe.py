@@ -42,14 +42,15 @@ class TrainingProbe:
     def __init__(
         self,
         cfg: DictConfig,
-        out: Path,
+        out: Path | None,
         cell: EvalCell,
         units: int,
         steps: int,
         train_cfg: dict,
         command_x: list[float] | None = None,
     ):
-        """`train_cfg`: the rsl-rl runner config of the training (the networks to copy into);
+        """`out`: the CSV that `record` appends to (None: a probe that only evaluates);
+        `train_cfg`: the rsl-rl runner config of the training (the networks to copy into);
         `command_x`: forward commands (m/s) instead of the protocol's `eval.command_x`."""
         cfg = copy.deepcopy(cfg)
         cfg.eval.units, cfg.eval.steps = int(units), int(steps)
@@ -61,7 +62,7 @@ class TrainingProbe:
         self.policy = new_policy(cfg, self.env, train_cfg)
         self.seed = int(cfg.eval.seed)
         self.steps = int(steps)
-        self.out = Path(out)
+        self.out = Path(out) if out is not None else None
 
     @staticmethod
     def read(path: Path) -> list[dict]:

@@ -86,7 +86,6 @@ def write_clip(path: Path, frames: list[np.ndarray], fps: float) -> Path:
     in .gif), as a GIF beside it (same stem). Returns the file written; it appears complete
     or not at all."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     if path.suffix.lower() == ".gif":
         return write_gif(path, frames, fps)
     try:

@@ -20,6 +20,13 @@ LATEST, PREVIOUS = "latest.pt", "previous.pt"
 LOOP_STATE = "lca_loop_state"  # env, episode statistics, RNG and recurrent states
 
 
+def set_learning_rate(alg, rate: float) -> None:
+    """PPO's learning rate: the adaptive schedule's value and the optimizer's groups."""
+    alg.learning_rate = float(rate)
+    for group in alg.optimizer.param_groups:
+        group["lr"] = alg.learning_rate
+
+
 def _clone(hidden):
     if hidden is None:
         return None
@@ -110,9 +117,7 @@ class Checkpoints:
                 continue
             rate = (saved.get("infos") or {}).get("learning_rate")
             if not parts["optimizer"] and rate is not None:  # a fresh Adam at the run's rate
-                self.alg.learning_rate = float(rate)
-                for group in self.alg.optimizer.param_groups:
-                    group["lr"] = self.alg.learning_rate
+                set_learning_rate(self.alg, rate)
             # rsl-rl stores the index of the last finished iteration
             self.runner.current_learning_iteration = int(saved["iter"])
             self.start = self.runner.current_learning_iteration + 1

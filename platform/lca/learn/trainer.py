@@ -22,7 +22,7 @@ from rsl_rl.runners import OnPolicyRunner
 
 from lca.config.runtime import resolve_device
 from lca.learn import curriculum
-from lca.learn.checkpoints import LATEST, Checkpoints
+from lca.learn.checkpoints import LATEST, Checkpoints, set_learning_rate
 from lca.learn.command_curriculum import CommandCurriculum
 from lca.learn.episode_stats import EpisodeStats
 from lca.learn.exploration import apply_ceiling, noise_ceiling, set_initial_stds
@@ -119,9 +119,7 @@ class Trainer(Checkpoints):
         actor.requires_grad_(not frozen)
         self.alg.schedule = "fixed" if frozen else self.cfg.algo.schedule
         if not frozen:
-            self.alg.learning_rate = float(self.cfg.algo.learning_rate)
-            for group in self.alg.optimizer.param_groups:
-                group["lr"] = self.alg.learning_rate
+            set_learning_rate(self.alg, self.cfg.algo.learning_rate)
 
     def _curve_rows_before(self, iteration: int) -> list[dict]:
         """Curve rows of a resumed run up to its checkpoint (later rows are re-done)."""
