@@ -75,6 +75,7 @@ def test_unknown_terrain_type_in_mixture(override: str) -> None:
         (["task.num_envs=-5"], "task.num_envs"),
         (["task.reward_curriculum.by=vibes"], "task.reward_curriculum.by"),
         (["task.reward_curriculum.terms=[joy]"], "task.reward_curriculum.terms"),
+        (["task.reward_curriculum.unclipped=[joy]"], "task.reward_curriculum.unclipped"),
         (["actor.final_noise_std=2.0"], "actor.final_noise_std"),
         (["terrain.apron=-1"], "terrain.apron"),
         # one row per remaining check of the groups (lca/<layer>/config.py)

@@ -363,6 +363,20 @@ def test_only_positive_rewards_clips_all_but_the_termination_penalty():
     np.testing.assert_allclose(plain, [-4.0036, 0.003 - 0.0036, 0.003])
 
 
+def test_unclipped_terms_are_added_after_the_clip():
+    # env 1 is net-negative and alive: clipped to 0 unless its lin_vel_z cost is unclipped
+    state = make_state(3, base_lin_vel=[[0.0, 0.0, 0.3], [0.0, 0.0, 0.3], [0.0, 0.0, 0.0]])
+    ctx = make_ctx(state, terminated=np.array([True, False, False]))
+    weights = {"alive": 0.15, "lin_vel_z_l2": -2.0, "termination_penalty": -200.0}
+    unclipped = frozenset({"lin_vel_z_l2"})
+    total, _ = compute_rewards(ctx, weights, dt=0.02, only_positive=True, unclipped=unclipped)
+    # env 0: max(0, 0) - 0.0036 - 4; env 1: max(0.003, 0) - 0.0036; env 2: 0.003
+    np.testing.assert_allclose(total, [-4.0036, 0.003 - 0.0036, 0.003])
+    # without the clip the listed terms change nothing: the sum is the plain one
+    plain, _ = compute_rewards(ctx, weights, dt=0.02, unclipped=unclipped)
+    np.testing.assert_allclose(plain, compute_rewards(ctx, weights, dt=0.02)[0])
+
+
 def test_compute_rewards_without_terms_is_zero():
     total, terms = compute_rewards(make_ctx(make_state(3)), {}, dt=0.02)
     assert terms == {}

@@ -109,6 +109,10 @@ class RewardCurriculumConfig:
     # term -> factor on its weight at the start, falling linearly to 1 as the penalties reach
     # the table's (e.g. {phase_contact: 4}: step with the gait clock before anything else)
     boost: dict[str, float] = field(default_factory=dict)
+    # terms added after the clip, like the termination penalty: their gradient reaches the
+    # policy even while the clipped sum is negative (e.g. the posture terms, so that the
+    # posture forms with the gait instead of after it)
+    unclipped: list[str] = field(default_factory=list)
 
     def check(self) -> None:
         key = "task.reward_curriculum"
@@ -128,8 +132,9 @@ class RewardCurriculumConfig:
         )
         allowed = ("episode_length", "iterations", "tracking")
         require(self.by in allowed, f"{key}.by", f"unknown '{self.by}'; allowed: {allowed}")
-        for name in self.terms:
-            REWARD_TERMS.check(name, f"{key}.terms")
+        for part in ("terms", "unclipped"):
+            for name in getattr(self, part):
+                REWARD_TERMS.check(name, f"{key}.{part}")
         for name, factor in self.boost.items():
             REWARD_TERMS.check(name, f"{key}.boost.{name}")
             require(factor > 0, f"{key}.boost.{name}", f"must be > 0, got {factor}")

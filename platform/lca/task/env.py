@@ -85,6 +85,7 @@ class LocomotionEnv(VecEnv):
         self.penalty_scale, self.boosts = 1.0, {}
         self.only_positive = bool(task.only_positive_rewards)
         self.scaled_terms = frozenset(task.reward_curriculum.terms) or None
+        self.unclipped = frozenset(task.reward_curriculum.unclipped)
         self.perception = bool(task.perception)
         self.height_noise = float(cfg.difficulty.height_noise) if task.observations.noise else 0.0
 
@@ -168,6 +169,7 @@ class LocomotionEnv(VecEnv):
             only_positive=self.only_positive,
             penalty_scale=self.penalty_scale,
             scaled_terms=self.scaled_terms,
+            unclipped=self.unclipped,
             params=self.reward_term_params,
             boosts=self.boosts,
             fns=self.reward_fns,

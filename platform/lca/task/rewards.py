@@ -222,6 +222,7 @@ def compute_rewards(
     only_positive: bool = False,
     penalty_scale: float = 1.0,
     scaled_terms: frozenset[str] | None = None,
+    unclipped: frozenset[str] = frozenset(),
     params: dict[str, dict] | None = None,
     boosts: dict[str, float] | None = None,
     fns: dict[str, Callable] | None = None,
@@ -235,7 +236,8 @@ def compute_rewards(
     (looked up here when not given). `only_positive` (legged_gym's
     `only_positive_rewards`) clips the sum of all terms but the termination penalty at zero
     before adding that penalty: while a young policy's penalties outweigh its rewards, living
-    longer would otherwise cost more than falling early."""
+    longer would otherwise cost more than falling early. The `unclipped` terms are added
+    after the clip too, so their gradient reaches the policy whatever the clipped sum."""
     terms = {}
     params, boosts = params or {}, boosts or {}
     fns = fns or {name: REWARD_TERMS[name] for name in weights}
@@ -244,10 +246,13 @@ def compute_rewards(
         if penalty_scale != 1.0 and (scaled_terms is None or name in scaled_terms):
             value = np.where(value < 0, penalty_scale * value, value)
         terms[name] = value
-    total = np.zeros(len(ctx.command))
+    after_clip = unclipped | {"termination_penalty"} if only_positive else frozenset()
+    total, outside = np.zeros(len(ctx.command)), np.zeros(len(ctx.command))
     for name, value in terms.items():
-        if not (only_positive and name == "termination_penalty"):
+        if name in after_clip:
+            outside = outside + value
+        else:
             total = total + value
     if only_positive:
-        total = np.clip(total, 0.0, None) + terms.get("termination_penalty", 0.0)
-    return total, terms
+        total = np.clip(total, 0.0, None)
+    return total + outside, terms

@@ -25,4 +25,6 @@ def step_metrics(
         "track_error": np.linalg.norm(error, axis=1),
         "command_speed": np.linalg.norm(command[:, :2], axis=1),
         "base_pos": state.base_pos.copy(),
+        "base_vel": state.base_lin_vel[:, :2].copy(),  # m/s, base frame
+        "yaw_rate": state.base_ang_vel[:, 2].copy(),  # rad/s
     }

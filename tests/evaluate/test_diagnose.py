@@ -1,0 +1,34 @@
+"""The diagnosis of a trained run: each command held, the reached velocity and every reward
+term per second under the paper's table."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from lca.evaluate import diagnose
+
+pytestmark = pytest.mark.slow  # evaluates a trained run: see README
+
+
+def test_diagnosis_holds_each_command_and_pays_per_second(evaluated_run, capsys):
+    _, run_path, _ = evaluated_run
+    assert diagnose.main([f"run_dir={run_path}", "units=2", "steps=60"]) == 0
+    commands = pd.read_csv(run_path / "diagnosis" / "commands.csv")
+    terms = pd.read_csv(run_path / "diagnosis" / "terms.csv", index_col="term")
+    assert list(commands["command"]) == list(diagnose.COMMANDS) == list(terms.columns)
+    np.testing.assert_allclose(commands[["u_x", "u_y", "u_yaw"]], list(diagnose.COMMANDS.values()))
+    assert ((commands["alive_s"] > 0) & (commands["alive_s"] <= 60 * 0.02)).all()
+    # per second of the steps each unit lived: the alive term is exactly its weight
+    np.testing.assert_allclose(terms.loc["alive"], 0.15)
+    np.testing.assert_allclose(terms.loc["total"], terms.drop("total").sum(), atol=1e-9)
+    # the held command decides which terms pay: stand_still only when told to stand
+    assert terms.loc["stand_still", "stand"] < 0
+    assert (terms.loc["stand_still"].drop("stand") == 0).all()
+    assert "reward per second" in capsys.readouterr().out
+
+
+def test_diagnosis_usage_error(capsys):
+    assert diagnose.main(["units=2"]) == 2
+    assert "run_dir=" in capsys.readouterr().err
