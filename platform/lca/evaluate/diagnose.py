@@ -79,7 +79,7 @@ def hold_command(
         env.commands.value[:] = command
         if not alive.any():
             break
-    response = dict(zip(("v_x", "v_y", "yaw_rate"), velocity / max(counted, 1)))
+    response = dict(zip(("v_x", "v_y", "yaw_rate"), velocity / max(counted, 1), strict=True))
     response["alive_s"] = alive_steps * env.dt / env.num_envs
     per_second = {name: total / max(alive_steps * env.dt, 1e-9) for name, total in sums.items()}
     return response, per_second
