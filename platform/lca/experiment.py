@@ -59,7 +59,9 @@ def estimate_seconds(overrides: list[str]) -> dict:
     ev = cfg.eval
     eval_steps = len(ev.cells) * ev.units * ev.episodes * ev.steps
     out = {"train_env_steps": int(train_steps), "eval_env_steps": int(eval_steps)}
-    train, env = BENCH_DIR / "train.json", BENCH_DIR / "env.json"
+    out["backend"] = cfg.sim.backend
+    suffix = "_warp" if cfg.sim.backend == "warp" else ""  # the chosen backend's own rates
+    train, env = BENCH_DIR / f"train{suffix}.json", BENCH_DIR / f"env{suffix}.json"
     if train.exists() and env.exists():
         train_rate = json.loads(train.read_text())["steps_per_s"]
         rows = json.loads(env.read_text())["batched"]
@@ -99,12 +101,12 @@ def main(argv: list[str] | None = None) -> int:
                 f"estimated cost: {cost['seconds'] / 3600:.2f} h per run, {total / 3600:.1f} "
                 f"core-pair hours in all (from {cost['train_steps_per_s']:,.0f} training and "
                 f"{cost['eval_steps_per_s']:,.0f} evaluation steps/s measured by "
-                "`python -m lca.bench train|env`)"
+                f"`python -m lca.bench train|env` with sim.backend={cost['backend']})"
             )
         else:
             print(
-                "estimated cost: unknown (run `python -m lca.bench train` and "
-                "`python -m lca.bench env` to measure throughput)"
+                "estimated cost: unknown (run `python -m lca.bench train` and `python -m "
+                f"lca.bench env` with sim.backend={cost['backend']} to measure throughput)"
             )
         print("command:", " ".join(sweep_command(spec, extra, runs_root)))
         return 0

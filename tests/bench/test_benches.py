@@ -7,6 +7,7 @@ from __future__ import annotations
 import pytest
 
 from lca.bench import env, sim, train
+from lca.bench.__main__ import result_name
 
 pytestmark = pytest.mark.slow  # steps the physics and trains: see README
 
@@ -34,8 +35,8 @@ def test_sim_verdict_follows_the_target() -> None:
 
 
 def test_env_bench_measures_env_against_raw_physics(monkeypatch) -> None:
-    monkeypatch.setattr(env, "NUM_ENVS", (8,))
-    monkeypatch.setattr(env, "THREADS", (1,))
+    monkeypatch.setattr(sim, "NUM_ENVS", (8,))
+    monkeypatch.setattr(sim, "THREADS", (1,))
     monkeypatch.setattr(env, "REPEATS", 1)
     monkeypatch.setattr(env, "MIN_SECONDS", 0.05)
     result = env.run(SMALL, log=None)
@@ -44,6 +45,23 @@ def test_env_bench_measures_env_against_raw_physics(monkeypatch) -> None:
     assert row["ratio"] == pytest.approx(row["steps_per_s"] / row["raw_steps_per_s"])
     assert 0 < row["ratio"] < 1.5  # the task adds work on top of the same physics
     assert result["max_rss_mb"] > 100
+
+
+def test_warp_backend_benches_over_worlds(monkeypatch) -> None:
+    pytest.importorskip("mujoco_warp", reason="the gpu extra")
+    monkeypatch.setattr(sim, "WARP_CPU_ENVS", (2,))
+    monkeypatch.setattr(sim, "REPEATS", 1)
+    monkeypatch.setattr(sim, "MIN_SECONDS", 0.05)
+    monkeypatch.setattr(env, "REPEATS", 1)
+    monkeypatch.setattr(env, "MIN_SECONDS", 0.05)
+    warp = [*SMALL, "sim.backend=warp", "sim.warp_device=cpu"]
+    lines: list[str] = []
+    physics = sim.run(warp, log=lines.append)
+    assert physics["backend"] == "warp" and [r["num_envs"] for r in physics["batched"]] == [2]
+    assert physics["batched"][0]["steps_per_s"] > 10 and lines[-1].startswith("warp N=")
+    (row,) = env.run(warp, log=None)["batched"]
+    assert 0 < row["ratio"] < 1.5
+    assert result_name("env", warp) == "env_warp.json" and result_name("env", SMALL) == "env.json"
 
 
 def test_env_verdict_follows_the_target() -> None:

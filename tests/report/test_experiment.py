@@ -9,6 +9,7 @@ from itertools import product
 import pytest
 from omegaconf import OmegaConf
 
+from lca import experiment
 from lca.config import compose
 
 from .helpers import REPO, run_python
@@ -95,6 +96,20 @@ def test_dry_run_hours_from_the_measured_rates(paper_plan: str) -> None:
     )
     hours = (3_932_160_000 / train_rate + 6_000_000 / eval_rate) / 3600
     assert f"estimated cost: {hours:.2f} h per run, {21 * hours:.1f} core-pair hours" in paper_plan
+
+
+def test_cost_estimate_reads_the_chosen_backends_rates(tmp_path, monkeypatch) -> None:
+    pytest.importorskip("mujoco_warp", reason="the gpu extra")
+    monkeypatch.setattr(experiment, "BENCH_DIR", tmp_path)
+    smoke = ["scale=smoke", "sim.backend=warp"]
+    assert "seconds" not in experiment.estimate_seconds(smoke)  # not measured: no guess
+    (tmp_path / "train_warp.json").write_text(json.dumps({"steps_per_s": 100.0}))
+    rows = [{"steps_per_s": 50.0}, {"steps_per_s": 200.0}]
+    (tmp_path / "env_warp.json").write_text(json.dumps({"batched": rows}))
+    (tmp_path / "train.json").write_text(json.dumps({"steps_per_s": 1.0}))  # mjbatch's: unused
+    cost = experiment.estimate_seconds(smoke)
+    expected = cost["train_env_steps"] / 100.0 + cost["eval_env_steps"] / 200.0
+    assert cost["backend"] == "warp" and cost["seconds"] == pytest.approx(expected)
 
 
 def test_hardware_experiment_plan() -> None:

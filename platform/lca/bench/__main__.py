@@ -12,6 +12,13 @@ from lca.paths import reports_dir
 BENCHMARKS = ("sim", "env", "train", "learn", "walk", "levers", "clips")
 
 
+def result_name(name: str, overrides: list[str]) -> str:
+    """`<name>.json`, or `<name>_warp.json` for the MuJoCo-Warp backend: the cost estimate of
+    `python -m lca.experiment --dry-run` reads the rate of the backend it plans for."""
+    warp = any(o.replace(" ", "") == "sim.backend=warp" for o in overrides)
+    return f"{name}_warp.json" if warp else f"{name}.json"
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m lca.bench")
     parser.add_argument("name", choices=BENCHMARKS)
@@ -22,7 +29,7 @@ def main(argv: list[str] | None = None) -> int:
     result = module.run(args.overrides, log=None if args.json else print)
     save_dir = reports_dir() / "bench"
     save_dir.mkdir(parents=True, exist_ok=True)
-    (save_dir / f"{args.name}.json").write_text(json.dumps(result, indent=2))
+    (save_dir / result_name(args.name, args.overrides)).write_text(json.dumps(result, indent=2))
     if args.json:
         print(json.dumps(result))
     else:

@@ -13,13 +13,12 @@ from collections.abc import Callable
 import numpy as np
 import torch
 
+from lca.bench.sim import sizes
 from lca.bench.timing import rate
 from lca.config import compose
 from lca.sim.scene import build_scene
 from lca.task.env import LocomotionEnv
 
-NUM_ENVS = (64, 256, 1024)
-THREADS = (1, 2)
 REPEATS = 3
 MIN_SECONDS = 1.5
 
@@ -77,16 +76,17 @@ def run(overrides: list[str], log: Callable[[str], None] | None = print) -> dict
     cfg = compose(overrides)
     scene = build_scene(cfg)
     rows = []
-    for num_envs in NUM_ENVS:
-        for threads in THREADS:
-            row = measure(cfg, scene, num_envs, threads)
-            rows.append(row)
-            if log:
-                log(
-                    f"N={num_envs:5d} threads={threads}: env {row['steps_per_s']:,.0f} /s, "
-                    f"raw {row['raw_steps_per_s']:,.0f} /s, ratio {row['ratio']:.2f}"
-                )
+    for num_envs, threads in sizes(cfg):
+        row = measure(cfg, scene, num_envs, threads)
+        rows.append(row)
+        if log:
+            log(
+                f"{cfg.sim.backend} N={num_envs:5d} threads={threads}: env "
+                f"{row['steps_per_s']:,.0f} /s, raw {row['raw_steps_per_s']:,.0f} /s, "
+                f"ratio {row['ratio']:.2f}"
+            )
     return {
+        "backend": cfg.sim.backend,
         "policy_steps": "per second, all envs",
         "max_rss_mb": _max_rss_mb(),
         "batched": rows,

@@ -12,11 +12,13 @@ import mujoco
 
 from lca.bench.timing import median_rate
 from lca.config import compose
-from lca.sim.batch import BatchedSim
+from lca.sim.backend import make_sim
 from lca.sim.scene import build_scene
 
 NUM_ENVS = (64, 256, 1024)
 THREADS = (1, 2)
+WARP_GPU_ENVS = (1024, 4096)
+WARP_CPU_ENVS = (16, 64)
 RESET_EVERY = 200  # physics steps (1 s)
 REPEATS = 3
 MIN_SECONDS = 1.0
@@ -38,8 +40,20 @@ def single_rate(model: mujoco.MjModel, key: int, decimation: int) -> float:
     return median_rate(chunk, REPEATS, MIN_SECONDS)
 
 
-def batched_rate(scene, num_envs: int, threads: int, decimation: int) -> float:
-    sim = BatchedSim(scene, num_envs, num_threads=threads, seed=0)
+def sizes(cfg) -> list[tuple[int, int]]:
+    """(num_envs, threads) rows: mjbatch over CPU threads; warp over worlds (a GPU at the
+    paper's 4096, warp's CPU device at a few)."""
+    if cfg.sim.backend != "warp":
+        return [(n, t) for n in NUM_ENVS for t in THREADS]
+    from lca.sim.warp_batch import warp_device
+
+    on_gpu = warp_device(cfg.sim.warp_device).startswith("cuda")
+    return [(n, 0) for n in (WARP_GPU_ENVS if on_gpu else WARP_CPU_ENVS)]
+
+
+def batched_rate(scene, sim_cfg, num_envs: int, threads: int, decimation: int) -> float:
+    sim_cfg.num_threads = threads
+    sim = make_sim(scene, num_envs, sim_cfg, seed=0)
     sim.reset()
     counter = [0]
 
@@ -61,16 +75,15 @@ def run(overrides: list[str], log: Callable[[str], None] | None = print) -> dict
     if log:
         log(f"single mj_step loop: {single:,.0f} steps/s")
     rows = []
-    for num_envs in NUM_ENVS:
-        for threads in THREADS:
-            steps = batched_rate(scene, num_envs, threads, decimation)
-            rows.append({"num_envs": num_envs, "threads": threads, "steps_per_s": steps})
-            if log:
-                log(
-                    f"mjbatch N={num_envs:5d} threads={threads}: {steps:,.0f} steps/s "
-                    f"({steps / single:.2f}x single)"
-                )
-    return {"single_steps_per_s": single, "batched": rows}
+    for num_envs, threads in sizes(cfg):
+        steps = batched_rate(scene, cfg.sim, num_envs, threads, decimation)
+        rows.append({"num_envs": num_envs, "threads": threads, "steps_per_s": steps})
+        if log:
+            log(
+                f"{cfg.sim.backend} N={num_envs:5d} threads={threads}: {steps:,.0f} steps/s "
+                f"({steps / single:.2f}x single)"
+            )
+    return {"backend": cfg.sim.backend, "single_steps_per_s": single, "batched": rows}
 
 
 def table(result: dict) -> str:

@@ -35,6 +35,8 @@ class BatchedSim:
         self.actuator_force = self.batch.bind("actuator_force")
         self.sensordata = self.batch.bind("sensordata")
         self.time = self.batch.bind("time")
+        self.warnings = self.batch.bind("warning")  # (N, mjNWARNING, 2): [lastinfo, number]
+        self.overflows = np.zeros(num_envs, dtype=np.int64)  # MuJoCo C grows its buffers
         self.rng = np.random.default_rng(seed)
         centres = scene.terrain.tile_centres()
         self.env_tile = np.arange(num_envs) % len(centres)
@@ -105,6 +107,17 @@ class BatchedSim:
         self.ctrl[ids] = self.scene.home_joint_pos
         self.batch.forward(ids)
 
+    def get_state(self) -> np.ndarray:
+        """(N, S) integration state (mjSTATE_INTEGRATION), as a checkpoint carries it."""
+        return self.batch.bind("state").copy()
+
+    def set_state(self, state: np.ndarray) -> None:
+        self.batch.bind("state")[:] = state
+
+    def set_const(self, ids: np.ndarray) -> None:
+        """Derived model constants of `ids` recomputed after a model change."""
+        self.batch.set_const(np.asarray(ids))
+
     def set_friction_scale(self, ids: np.ndarray, scale: np.ndarray) -> None:
         """Sliding friction of every geom of env i = nominal * scale[i]."""
         if self._friction is None:
@@ -116,4 +129,4 @@ class BatchedSim:
         if self._body_mass is None:
             self._body_mass = self.batch.expand("body_mass")
         self._body_mass[ids, self.base_body] = self._nominal_mass[self.base_body] + added
-        self.batch.set_const(np.asarray(ids))
+        self.set_const(ids)

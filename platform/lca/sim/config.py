@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib.util
 from dataclasses import dataclass, field
 
 from omegaconf import MISSING
@@ -22,6 +23,11 @@ class SimConfig:
     ls_iterations: int = 5
     bvactive: bool = False  # MuJoCo's default (on) makes stepping ~3x slower
     num_threads: int = 0  # mjbatch worker threads; 0 = every logical CPU
+    # mjbatch: MuJoCo C on CPU threads; warp: MuJoCo-Warp (pip install -e ".[gpu]")
+    backend: str = "mjbatch"
+    warp_device: str = "auto"  # auto: cuda when warp sees a GPU, else warp's CPU device
+    nconmax: int = 0  # warp's contacts per world; 0: sized from the scene's colliding geoms
+    njmax: int = 0  # warp's constraint rows per world; 0: sized from the contacts and limits
 
     def check(self) -> None:
         require(self.timestep > 0, "sim.timestep", f"must be > 0, got {self.timestep}")
@@ -30,6 +36,16 @@ class SimConfig:
         require(self.integrator in allowed, "sim.integrator", f"allowed: {allowed}")
         require(self.cone in ("pyramidal", "elliptic"), "sim.cone", "allowed: pyramidal, elliptic")
         require(self.iterations >= 1, "sim.iterations", f"must be >= 1, got {self.iterations}")
+        allowed = ("mjbatch", "warp")
+        require(
+            self.backend in allowed, "sim.backend", f"unknown '{self.backend}'; allowed: {allowed}"
+        )
+        require(
+            self.backend != "warp" or importlib.util.find_spec("mujoco_warp") is not None,
+            "sim.backend",
+            "warp needs MuJoCo-Warp, which is not installed: pip install -e '.[gpu]'",
+        )
+        require(self.nconmax >= 0 and self.njmax >= 0, "sim.nconmax/njmax", "must be >= 0")
 
 
 @dataclass

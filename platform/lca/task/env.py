@@ -18,7 +18,7 @@ from tensordict import TensorDict
 
 from lca.config.registry import REWARD_TERMS
 from lca.config.runtime import resolve_device
-from lca.sim.batch import BatchedSim
+from lca.sim.backend import make_sim
 from lca.sim.depth_camera import CameraSpec, DepthCameras
 from lca.sim.scene import Scene, build_scene
 from lca.task import heightmap, observations, perception
@@ -62,7 +62,7 @@ class LocomotionEnv(VecEnv):
         self.device = torch.device(resolve_device(cfg.device))
         self.num_envs = int(task.num_envs)
         self.scene = scene if scene is not None else build_scene(cfg)
-        self.sim = BatchedSim(self.scene, self.num_envs, cfg.sim.num_threads, seed=cfg.seed)
+        self.sim = make_sim(self.scene, self.num_envs, cfg.sim, seed=cfg.seed)
         self.rng = np.random.default_rng(cfg.seed + 1)
         self.decimation = int(cfg.sim.decimation)
         self.dt = cfg.sim.timestep * self.decimation
@@ -104,12 +104,16 @@ class LocomotionEnv(VecEnv):
         self.perception_cfg = OmegaConf.to_object(cfg.perception)
         self.cameras = None
         if self.perception_cfg.source == "deployment":
+            if cfg.sim.backend != "mjbatch":
+                raise ValueError(
+                    "perception.source=deployment casts rays with sim.backend=mjbatch only"
+                )
             specs = [CameraSpec(**vars(c)) for c in self.perception_cfg.cameras]
             self.cameras = DepthCameras(self.sim, specs, self.rng)
             self._camera_frame = np.full(self.num_envs, -1)
             self._deployment_map = np.zeros((self.num_envs, self.actor_offsets.shape[0]))
         self.contacts = ContactAccumulator(self.sim)
-        self.warnings = self.sim.batch.bind("warning")
+        self.warnings = self.sim.warnings
         self.episode_length_buf = torch.zeros(self.num_envs, dtype=torch.long, device=self.device)
         self._episode_steps = np.zeros(self.num_envs, dtype=np.int64)
         self.action = np.zeros((self.num_envs, self.num_actions))
@@ -191,6 +195,7 @@ class LocomotionEnv(VecEnv):
         self.nonfinite_actions += int(bad_action.sum())
         extras["log"]["Episode_Termination/nonfinite_total"] = float(self.nonfinite_resets)
         extras["log"]["Episode_Termination/nonfinite_actions_total"] = float(self.nonfinite_actions)
+        extras["log"]["Sim/buffer_overflows_total"] = float(self.sim.overflows.sum())
         extras["metrics"]["fell"] = fallen
         extras["metrics"]["nonfinite"] = broken
         extras["metrics"]["nonfinite_action"] = bad_action

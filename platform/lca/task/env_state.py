@@ -21,7 +21,7 @@ COUNTERS = ("nonfinite_resets", "nonfinite_actions", "penalty_scale", "only_posi
 def env_state(env) -> dict:
     sim = env.sim
     state = {
-        "sim": sim.batch.bind("state").copy(),
+        "sim": sim.get_state(),
         "warning": env.warnings.copy(),
         "friction": None if sim._friction is None else sim._friction.copy(),
         "body_mass": None if sim._body_mass is None else sim._body_mass.copy(),
@@ -50,19 +50,20 @@ def env_state(env) -> dict:
 def restore_env_state(env, state: dict) -> None:
     """Put `state` (from `env_state` of an env built from the same config) back."""
     sim = env.sim
-    if state["sim"].shape != sim.batch.bind("state").shape:
+    shape = sim.get_state().shape
+    if state["sim"].shape != shape:
         raise ValueError(
             f"saved env state is for {state['sim'].shape[0]} envs of state size "
-            f"{state['sim'].shape[1]}; this env has {sim.batch.bind('state').shape}"
+            f"{state['sim'].shape[1]}; this env has {shape}"
         )
-    sim.batch.bind("state")[:] = state["sim"]
+    sim.set_state(state["sim"])
     env.warnings[:] = state["warning"]
     if state["friction"] is not None:
         sim.set_friction_scale(np.arange(env.num_envs), np.ones(env.num_envs))  # expand
         sim._friction[:] = state["friction"]
     if state["body_mass"] is not None:
         sim._body_mass[:] = state["body_mass"]
-        sim.batch.set_const(np.arange(env.num_envs))
+        sim.set_const(np.arange(env.num_envs))
     env.history.buffer[:] = state["history"]
     env.critic_history.buffer[:] = state["critic_history"]
     env.commands.value[:] = state["commands"]["value"]
