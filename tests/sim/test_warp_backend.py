@@ -11,6 +11,8 @@ and solves contacts with its own kernels, so the two drift apart slowly: they ar
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -28,9 +30,11 @@ from lca.sim.scene import Scene  # noqa: E402
 from lca.sim.warp_batch import WarpSim, buffer_sizes  # noqa: E402
 from lca.task.env import LocomotionEnv  # noqa: E402
 
+# warp's CPU device in CI; .ci/gpu_check runs the same tests with LCA_WARP_DEVICE=cuda
+DEVICE = os.environ.get("LCA_WARP_DEVICE", "cpu")
 WORLDS = 4
 ENV = ["scale=smoke", "task.num_envs=4", "task.observations.noise=false", "sim.num_threads=1"]
-WARP = ["sim.backend=warp", "sim.warp_device=cpu"]
+WARP = ["sim.backend=warp", f"sim.warp_device={DEVICE}"]
 
 
 def drive(sim, scene: Scene, steps: int) -> np.ndarray:
@@ -47,7 +51,7 @@ def drive(sim, scene: Scene, steps: int) -> np.ndarray:
 
 def test_warp_steps_the_scene_as_mjbatch_does(mixed_scene: Scene) -> None:
     c = drive(BatchedSim(mixed_scene, WORLDS, num_threads=1), mixed_scene, 50)
-    w = drive(WarpSim(mixed_scene, WORLDS, "cpu"), mixed_scene, 50)
+    w = drive(WarpSim(mixed_scene, WORLDS, DEVICE), mixed_scene, 50)
     assert np.abs(c[-1, :, 2] - c[0, :, 2]).max() > 0.01  # the robots moved
     np.testing.assert_allclose(w[:, :, :3], c[:, :, :3], atol=5e-3)
     joints = np.abs(w[:, :, 7:] - c[:, :, 7:])
@@ -80,7 +84,7 @@ def test_task_on_warp_matches_the_task_on_mjbatch(mixed_cfg) -> None:
 
 
 def test_state_round_trip_is_exact(flat_scene: Scene) -> None:
-    sim = WarpSim(flat_scene, 2, "cpu")
+    sim = WarpSim(flat_scene, 2, DEVICE)
     sim.reset()
     sim.step(8)
     saved = sim.get_state()
@@ -92,7 +96,7 @@ def test_state_round_trip_is_exact(flat_scene: Scene) -> None:
 
 
 def test_buffer_overflows_are_counted_not_printed(flat_scene: Scene, capfd) -> None:
-    sim = WarpSim(flat_scene, 2, "cpu", nconmax=1, njmax=4)
+    sim = WarpSim(flat_scene, 2, DEVICE, nconmax=1, njmax=4)
     sim.reset()
     sim.step(20)
     assert (sim.overflows > 0).all()
