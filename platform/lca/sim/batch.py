@@ -20,6 +20,33 @@ def yaw_quat(yaw: np.ndarray) -> np.ndarray:
     return np.stack([np.cos(yaw / 2), np.zeros_like(yaw), np.zeros_like(yaw), np.sin(yaw / 2)], -1)
 
 
+def place_home(sim, ids: np.ndarray, noise: ResetConfig | None) -> None:
+    """Put the just-reset envs `ids` of a batched sim (mjbatch or warp) in the `home` pose on
+    their own tile, with uniform noise on position, heading and joints; ctrl holds home."""
+    n = ids.size
+    xy = sim.env_origin[ids].copy()
+    yaw = np.zeros(n)
+    joints = np.tile(sim.scene.home_joint_pos, (n, 1))
+    if noise is not None:
+        xy += sim.rng.uniform(-noise.base_xy_noise, noise.base_xy_noise, (n, 2))
+        yaw = sim.rng.uniform(-noise.yaw_range, noise.yaw_range, n)
+        joints += sim.rng.uniform(-noise.joint_pos_noise, noise.joint_pos_noise, joints.shape)
+    ground = sim.scene.terrain.height_at(xy[:, 0], xy[:, 1])
+    qpos = sim.qpos[ids]
+    qpos[:, :2] = xy
+    qpos[:, 2] = ground + sim.scene.base_height
+    qpos[:, 3:7] = yaw_quat(yaw)
+    qpos[:, sim.joint_qpos] = joints
+    sim.qpos[ids] = qpos
+    if noise is not None and noise.joint_vel_noise > 0:
+        qvel = sim.qvel[ids]
+        qvel[:, sim.joint_dof] = sim.rng.uniform(
+            -noise.joint_vel_noise, noise.joint_vel_noise, joints.shape
+        )
+        sim.qvel[ids] = qvel
+    sim.ctrl[ids] = sim.scene.home_joint_pos
+
+
 class BatchedSim:
     """Live (N, ...) views: `qpos`, `qvel`, `ctrl`, `sensordata`, and `sensor(name)`."""
 
@@ -83,28 +110,7 @@ class BatchedSim:
         if ids.size == 0:
             return
         self.batch.reset(ids, keyframe=self.scene.home_key)
-        n = ids.size
-        xy = self.env_origin[ids].copy()
-        yaw = np.zeros(n)
-        joints = np.tile(self.scene.home_joint_pos, (n, 1))
-        if noise is not None:
-            xy += self.rng.uniform(-noise.base_xy_noise, noise.base_xy_noise, (n, 2))
-            yaw = self.rng.uniform(-noise.yaw_range, noise.yaw_range, n)
-            joints += self.rng.uniform(-noise.joint_pos_noise, noise.joint_pos_noise, joints.shape)
-        ground = self.scene.terrain.height_at(xy[:, 0], xy[:, 1])
-        qpos = self.qpos[ids]
-        qpos[:, :2] = xy
-        qpos[:, 2] = ground + self.scene.base_height
-        qpos[:, 3:7] = yaw_quat(yaw)
-        qpos[:, self.joint_qpos] = joints
-        self.qpos[ids] = qpos
-        if noise is not None and noise.joint_vel_noise > 0:
-            qvel = self.qvel[ids]
-            qvel[:, self.joint_dof] = self.rng.uniform(
-                -noise.joint_vel_noise, noise.joint_vel_noise, joints.shape
-            )
-            self.qvel[ids] = qvel
-        self.ctrl[ids] = self.scene.home_joint_pos
+        place_home(self, ids, noise)
         self.batch.forward(ids)
 
     def get_state(self) -> np.ndarray:

@@ -23,7 +23,7 @@ import numpy as np
 import warp as wp
 
 from lca.sim import robot as g1
-from lca.sim.batch import yaw_quat
+from lca.sim.batch import BatchedSim, place_home
 from lca.sim.config import ResetConfig
 from lca.sim.scene import Scene
 
@@ -139,11 +139,7 @@ class WarpSim:
             self.forward(None)
         return self._arrays[field][1]
 
-    def body_id(self, name: str) -> int:
-        found = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, name)
-        if found < 0:
-            raise KeyError(f"no body '{name}' in the scene")
-        return found
+    body_id = BatchedSim.body_id  # reads only the host model
 
     def step(self, nstep: int = 1, ids: np.ndarray | None = None) -> None:
         if ids is not None:
@@ -177,28 +173,7 @@ class WarpSim:
         with wp.ScopedDevice(self.device):
             mjw.reset_data_keyframe(self.m, self.d, wp.array(keys, dtype=int))
         self._pull()
-        n = ids.size
-        xy = self.env_origin[ids].copy()
-        yaw = np.zeros(n)
-        joints = np.tile(self.scene.home_joint_pos, (n, 1))
-        if noise is not None:
-            xy += self.rng.uniform(-noise.base_xy_noise, noise.base_xy_noise, (n, 2))
-            yaw = self.rng.uniform(-noise.yaw_range, noise.yaw_range, n)
-            joints += self.rng.uniform(-noise.joint_pos_noise, noise.joint_pos_noise, joints.shape)
-        ground = self.scene.terrain.height_at(xy[:, 0], xy[:, 1])
-        qpos = self.qpos[ids]
-        qpos[:, :2] = xy
-        qpos[:, 2] = ground + self.scene.base_height
-        qpos[:, 3:7] = yaw_quat(yaw)
-        qpos[:, self.joint_qpos] = joints
-        self.qpos[ids] = qpos
-        if noise is not None and noise.joint_vel_noise > 0:
-            qvel = self.qvel[ids]
-            qvel[:, self.joint_dof] = self.rng.uniform(
-                -noise.joint_vel_noise, noise.joint_vel_noise, joints.shape
-            )
-            self.qvel[ids] = qvel
-        self.ctrl[ids] = self.scene.home_joint_pos
+        place_home(self, ids, noise)
         self.forward(ids)
 
     def set_friction_scale(self, ids: np.ndarray, scale: np.ndarray) -> None:
