@@ -52,6 +52,13 @@ LEVERS: dict[str, tuple[str, list[str]]] = {
             "task.command_curriculum.widen_from.standing_fraction=0",
         ],
     ),
+    "posture_unclipped": (
+        "posture terms added after the clip (their gradient always reaches the policy)",
+        [
+            "task.reward_curriculum.unclipped=[joint_deviation_hip,joint_deviation_arms,"
+            "joint_deviation_torso,feet_flat,flat_orientation_l2,height_torso]"
+        ],
+    ),
     "init_noise_0.5": ("initial action std 0.5", ["actor.init_noise_std=0.5"]),
     "symmetry": ("mirror augmentation", ["algo.symmetry=true"]),
     "fixed_lr": ("fixed learning rate 3e-4", ["algo.schedule=fixed", "algo.learning_rate=3e-4"]),
