@@ -59,9 +59,13 @@ def test_warp_backend_benches_over_worlds(monkeypatch) -> None:
     physics = sim.run(warp, log=lines.append)
     assert physics["backend"] == "warp" and [r["num_envs"] for r in physics["batched"]] == [2]
     assert physics["batched"][0]["steps_per_s"] > 10 and lines[-1].startswith("warp N=")
-    (row,) = env.run(warp, log=None)["batched"]
+    measured = env.run(warp, log=None)
+    (row,) = measured["batched"]
     assert 0 < row["ratio"] < 1.5
-    assert result_name("env", warp) == "env_warp.json" and result_name("env", SMALL) == "env.json"
+    plain = {"backend": "mjbatch"}
+    assert (
+        result_name("env", measured) == "env_warp.json" and result_name("env", plain) == "env.json"
+    )
 
 
 def test_env_verdict_follows_the_target() -> None:

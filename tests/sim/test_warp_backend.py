@@ -130,3 +130,8 @@ def test_warp_without_the_extra_fails_at_composition(monkeypatch) -> None:
         compose(["sim.backend=warp"])
     with pytest.raises(ConfigValueError, match="allowed"):
         compose(["sim.backend=jax"])
+
+
+def test_deployment_cameras_need_mjbatch() -> None:
+    with pytest.raises(ConfigValueError, match=r"^perception.source: .*sim.backend=mjbatch"):
+        compose(["sim.backend=warp", "perception=deployment"])

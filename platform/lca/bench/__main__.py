@@ -12,11 +12,11 @@ from lca.paths import reports_dir
 BENCHMARKS = ("sim", "env", "train", "learn", "walk", "levers", "clips")
 
 
-def result_name(name: str, overrides: list[str]) -> str:
-    """`<name>.json`, or `<name>_warp.json` for the MuJoCo-Warp backend: the cost estimate of
-    `python -m lca.experiment --dry-run` reads the rate of the backend it plans for."""
-    warp = any(o.replace(" ", "") == "sim.backend=warp" for o in overrides)
-    return f"{name}_warp.json" if warp else f"{name}.json"
+def result_name(name: str, result: dict) -> str:
+    """`<name>.json`, or `<name>_warp.json` when the benchmark ran on the MuJoCo-Warp backend
+    (its result says so): `python -m lca.experiment --dry-run` reads the rate of the backend
+    it plans for."""
+    return f"{name}_warp.json" if result.get("backend") == "warp" else f"{name}.json"
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -29,7 +29,7 @@ def main(argv: list[str] | None = None) -> int:
     result = module.run(args.overrides, log=None if args.json else print)
     save_dir = reports_dir() / "bench"
     save_dir.mkdir(parents=True, exist_ok=True)
-    (save_dir / result_name(args.name, args.overrides)).write_text(json.dumps(result, indent=2))
+    (save_dir / result_name(args.name, result)).write_text(json.dumps(result, indent=2))
     if args.json:
         print(json.dumps(result))
     else:

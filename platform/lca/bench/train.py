@@ -42,6 +42,7 @@ def measure(overrides: list[str], log: Callable[[str], None] | None = print) -> 
     update = np.array([float(r["update_s"]) for r in rows])
     samples = cfg.algo.num_steps_per_env * cfg.task.num_envs
     result = {
+        "backend": cfg.sim.backend,
         "num_envs": int(cfg.task.num_envs),
         "steps_per_env": int(cfg.algo.num_steps_per_env),
         "learning_epochs": int(cfg.algo.num_learning_epochs),

@@ -10,6 +10,7 @@ from hydra.core.override_parser.overrides_parser import OverridesParser
 from omegaconf import DictConfig, OmegaConf
 
 from lca.config import schema
+from lca.config.errors import require
 from lca.config.policies import label_policy
 from lca.config.schema import ConfigValueError
 from lca.paths import conf_dir
@@ -57,6 +58,11 @@ def validate(cfg: DictConfig) -> None:
         check = getattr(group, "check", None)
         if callable(check):
             check()
+    require(
+        obj.sim.backend == "mjbatch" or obj.perception.source == "privileged",
+        "perception.source",
+        "deployment casts its camera rays with sim.backend=mjbatch only",
+    )
 
 
 def load_option(group: str, name: str) -> DictConfig:

@@ -47,6 +47,24 @@ def place_home(sim, ids: np.ndarray, noise: ResetConfig | None) -> None:
     sim.ctrl[ids] = sim.scene.home_joint_pos
 
 
+def host_layout(sim, scene: Scene, num_envs: int, seed: int) -> None:
+    """What every batched sim (mjbatch or warp) keeps on the host: the reset RNG, each env's
+    tile and origin, the nominal friction and mass that randomisation scales, the base body
+    and the robot's joint slices."""
+    sim.rng = np.random.default_rng(seed)
+    centres = scene.terrain.tile_centres()
+    sim.env_tile = np.arange(num_envs) % len(centres)
+    sim.env_origin = centres[sim.env_tile]
+    sim._friction = sim._body_mass = None
+    sim._nominal_friction = scene.model.geom_friction[:, 0].copy()
+    sim._nominal_mass = scene.model.body_mass.copy()
+    sim.base_body = mujoco.mj_name2id(scene.model, mujoco.mjtObj.mjOBJ_BODY, g1.BASE_BODY)
+    # The robot's joints come first; task objects (a hinged plank) may follow them.
+    num_joints = len(scene.joint_names)
+    sim.joint_qpos = slice(7, 7 + num_joints)
+    sim.joint_dof = slice(6, 6 + num_joints)
+
+
 class BatchedSim:
     """Live (N, ...) views: `qpos`, `qvel`, `ctrl`, `sensordata`, and `sensor(name)`."""
 
@@ -64,20 +82,8 @@ class BatchedSim:
         self.time = self.batch.bind("time")
         self.warnings = self.batch.bind("warning")  # (N, mjNWARNING, 2): [lastinfo, number]
         self.overflows = np.zeros(num_envs, dtype=np.int64)  # MuJoCo C grows its buffers
-        self.rng = np.random.default_rng(seed)
-        centres = scene.terrain.tile_centres()
-        self.env_tile = np.arange(num_envs) % len(centres)
-        self.env_origin = centres[self.env_tile]
-        self._friction = None
         self._views: dict[str, np.ndarray] = {}
-        self._body_mass = None
-        self._nominal_friction = self.model.geom_friction[:, 0].copy()
-        self._nominal_mass = self.model.body_mass.copy()
-        self.base_body = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, g1.BASE_BODY)
-        # The robot's joints come first; task objects (a hinged plank) may follow them.
-        num_joints = len(scene.joint_names)
-        self.joint_qpos = slice(7, 7 + num_joints)
-        self.joint_dof = slice(6, 6 + num_joints)
+        host_layout(self, scene, num_envs, seed)
 
     def sensor(self, name: str) -> np.ndarray:
         return self.batch.sensor(name)

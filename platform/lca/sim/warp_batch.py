@@ -22,8 +22,7 @@ import mujoco_warp as mjw
 import numpy as np
 import warp as wp
 
-from lca.sim import robot as g1
-from lca.sim.batch import BatchedSim, place_home
+from lca.sim.batch import BatchedSim, host_layout, place_home
 from lca.sim.config import ResetConfig
 from lca.sim.scene import Scene
 
@@ -33,6 +32,7 @@ CONTACTS_PER_GEOM = 4  # a sphere on a heightfield touches up to a few prisms
 ROWS_PER_CONTACT = 4  # pyramidal friction cone, condim 3: 2 (condim - 1) rows
 # overflow bits of a buffer too small (contacts dropped); the solver's iteration limits
 # (ITERATIONS, LS_ITERATIONS) are counted apart: bounded solver work is the config's choice
+N_WARNINGS = int(mujoco.mjtWarning.mjNWARNING)
 SOLVER_LIMITS = int(mjw.OverflowType.ITERATIONS | mjw.OverflowType.LS_ITERATIONS)
 
 
@@ -92,18 +92,8 @@ class WarpSim:
         self.solver_limits = np.zeros(num_envs, dtype=np.int64)  # steps at an iteration limit
         # mjData.warning's shape (N, mjNWARNING, 2): warp keeps no warnings; NaNs are caught
         # from the state by the task
-        self.warnings = np.zeros((num_envs, len(mujoco.MjData(self.model).warning), 2), np.int32)
-        self.rng = np.random.default_rng(seed)
-        centres = scene.terrain.tile_centres()
-        self.env_tile = np.arange(num_envs) % len(centres)
-        self.env_origin = centres[self.env_tile]
-        self._nominal_friction = self.model.geom_friction[:, 0].copy()
-        self._nominal_mass = self.model.body_mass.copy()
-        self._friction = self._body_mass = None
-        self.base_body = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, g1.BASE_BODY)
-        num_joints = len(scene.joint_names)
-        self.joint_qpos = slice(7, 7 + num_joints)
-        self.joint_dof = slice(6, 6 + num_joints)
+        self.warnings = np.zeros((num_envs, N_WARNINGS, 2), np.int32)
+        host_layout(self, scene, num_envs, seed)
         self._sensor_adr = {
             self.model.sensor(i).name: (self.model.sensor_adr[i], self.model.sensor_dim[i])
             for i in range(self.model.nsensor)

@@ -104,10 +104,6 @@ class LocomotionEnv(VecEnv):
         self.perception_cfg = OmegaConf.to_object(cfg.perception)
         self.cameras = None
         if self.perception_cfg.source == "deployment":
-            if cfg.sim.backend != "mjbatch":
-                raise ValueError(
-                    "perception.source=deployment casts rays with sim.backend=mjbatch only"
-                )
             specs = [CameraSpec(**vars(c)) for c in self.perception_cfg.cameras]
             self.cameras = DepthCameras(self.sim, specs, self.rng)
             self._camera_frame = np.full(self.num_envs, -1)
