@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from lca.arrays import Array, arrays, device_of, like, namespace
 from lca.config.registry import TILES
 from lca.sim.config import DifficultyConfig, TerrainConfig
 
@@ -36,6 +37,7 @@ class Terrain:
     resolution: float
     origin: tuple[float, float]
     tiles: list[Tile]
+    _flat: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     @property
     def size(self) -> tuple[float, float]:
@@ -51,30 +53,41 @@ class Terrain:
     def tile_centres(self) -> np.ndarray:
         return np.array([t.centre for t in self.tiles])
 
-    def height_at(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    def height_at(self, x: Array, y: Array) -> Array:
         """Surface height at world points, exactly as MuJoCo's heightfield triangulates it.
 
         Each grid cell is split along the diagonal from sample (r, c) to (r+1, c+1); points
-        outside the grid are clamped to its edge.
+        outside the grid are clamped to its edge. NumPy or torch points (numbers: NumPy).
         """
-        x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
+        x, y = arrays(x, y)
+        xp = namespace(x, y)
+        x, y = xp.broadcast_arrays(x, y)
         nrow, ncol = self.heights.shape
-        u = np.clip((x - self.origin[0]) / self.resolution, 0, ncol - 1)
-        v = np.clip((y - self.origin[1]) / self.resolution, 0, nrow - 1)
-        c = np.minimum(u.astype(np.int64), ncol - 2)  # u >= 0, so truncation is floor
-        r = np.minimum(v.astype(np.int64), nrow - 2)
-        fx, fy = u - c, v - r
+        u = xp.clip((x - self.origin[0]) / self.resolution, min=0, max=ncol - 1)
+        v = xp.clip((y - self.origin[1]) / self.resolution, min=0, max=nrow - 1)
+        c = xp.clip(xp.astype(u, xp.int64), max=ncol - 2)  # u >= 0, so truncation is floor
+        r = xp.clip(xp.astype(v, xp.int64), max=nrow - 2)
+        fx, fy = u - xp.astype(c, u.dtype), v - xp.astype(r, v.dtype)
         # flat gathers are much faster than 2-D fancy indexing on a large grid
-        flat = self.heights.ravel()
-        i00 = r * ncol + c
-        h00, h01 = flat.take(i00), flat.take(i00 + 1)
-        h10, h11 = flat.take(i00 + ncol), flat.take(i00 + ncol + 1)
+        flat, i00 = self._flat_heights(u), r * ncol + c
+
+        def at(index: Array) -> Array:
+            return xp.reshape(xp.take(flat, xp.reshape(index, (-1,))), index.shape)
+
+        h00, h01, h10, h11 = at(i00), at(i00 + 1), at(i00 + ncol), at(i00 + ncol + 1)
         lower = fx >= fy  # triangle (r,c), (r,c+1), (r+1,c+1)
-        return np.where(
+        return xp.where(
             lower,
             h00 + fx * (h01 - h00) + fy * (h11 - h01),
             h00 + fy * (h10 - h00) + fx * (h11 - h10),
         )
+
+    def _flat_heights(self, reference: Array) -> Array:
+        """The grid, flattened, in `reference`'s array type, dtype and device (cached)."""
+        key = (type(reference).__module__, str(device_of(reference)), str(reference.dtype))
+        if key not in self._flat:
+            self._flat[key] = like(self.heights.ravel(), reference)
+        return self._flat[key]
 
 
 def tile_kinds(cfg: TerrainConfig, rng: np.random.Generator) -> list[str]:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from lca.arrays import Array, namespace
 from lca.task.config import CommandConfig
 
 
@@ -55,7 +56,8 @@ def _at_least(planar: np.ndarray, floor: float) -> np.ndarray:
     return np.where(speed < floor, direction * floor, planar)
 
 
-def gait_phase(episode_time: np.ndarray, period: float) -> np.ndarray:
+def gait_phase(episode_time: Array, period: float) -> Array:
     """(N, 2) phase in [0, 1) of the left and right foot, half a period apart."""
-    phi = np.mod(episode_time / period, 1.0)
-    return np.stack([phi, np.mod(phi + 0.5, 1.0)], axis=1)
+    xp = namespace(episode_time)
+    phi = xp.remainder(episode_time / period, 1.0)
+    return xp.stack([phi, xp.remainder(phi + 0.5, 1.0)], axis=1)

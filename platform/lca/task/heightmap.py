@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from lca.arrays import Array, like, namespace
 from lca.sim.terrain import Terrain
 
 
@@ -24,25 +25,26 @@ def grid_offsets(shape: tuple[int, int], spacing: float) -> np.ndarray:
     return np.stack([gx.ravel(), gy.ravel()], axis=1)
 
 
-def sample_heights(
-    terrain: Terrain, base_xy: np.ndarray, yaw: np.ndarray, offsets: np.ndarray
-) -> np.ndarray:
-    """(N, P) terrain heights at offsets rotated by each base's yaw."""
-    cos, sin = np.cos(yaw)[:, None], np.sin(yaw)[:, None]
+def sample_heights(terrain: Terrain, base_xy: Array, yaw: Array, offsets: Array) -> Array:
+    """(N, P) terrain heights at offsets rotated by each base's yaw (NumPy or torch)."""
+    xp = namespace(base_xy, yaw)
+    offsets = like(offsets, base_xy)
+    cos, sin = xp.cos(yaw)[:, None], xp.sin(yaw)[:, None]
     x = base_xy[:, :1] + cos * offsets[None, :, 0] - sin * offsets[None, :, 1]
     y = base_xy[:, 1:2] + sin * offsets[None, :, 0] + cos * offsets[None, :, 1]
     return terrain.height_at(x, y)
 
 
-def normalise(heights: np.ndarray, valid: np.ndarray | None = None) -> np.ndarray:
+def normalise(heights: Array, valid: Array | None = None) -> Array:
     """Subtract each grid's mean (over valid cells), zero invalid cells, clip to [-1, 1]."""
+    xp = namespace(heights)
     if valid is None:
-        centred = heights - heights.mean(axis=1, keepdims=True)
+        centred = heights - xp.mean(heights, axis=1, keepdims=True)
     else:
-        count = np.maximum(valid.sum(axis=1, keepdims=True), 1)
-        mean = np.where(valid, heights, 0.0).sum(axis=1, keepdims=True) / count
-        centred = np.where(valid, heights - mean, 0.0)
-    return np.clip(centred, -1.0, 1.0)
+        count = xp.clip(xp.sum(valid, axis=1, keepdims=True), min=1)
+        mean = xp.sum(xp.where(valid, heights, 0.0), axis=1, keepdims=True) / count
+        centred = xp.where(valid, heights - mean, 0.0)
+    return xp.clip(centred, min=-1.0, max=1.0)
 
 
 def actor_map(

@@ -3,16 +3,19 @@
 Terms are declared in task.observations (name, scale, noise, clip) and registered here by
 name; `build` serves the env and `lca.describe` alike. Noise is added to the raw value, then
 the scale applied (IsaacLab's order). The history holds K frames of the proprioception terms
-(the paper's: joint_pos, joint_vel, base_ang_vel, projected_gravity), newest first.
+(the paper's: joint_pos, joint_vel, base_ang_vel, projected_gravity), newest first. Like the
+reward terms, they run on NumPy arrays and torch tensors alike (lca.arrays).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
+from lca.arrays import Array, device_of, like, namespace, uniform
 from lca.config.registry import OBS_TERMS
 from lca.task.state import RobotState
 
@@ -27,7 +30,7 @@ class Term:
     scale: float | tuple[float, ...] = 1.0
     noise: float = 0.0  # half-width of uniform noise on the raw value
     clip: float | None = None
-    value: Callable[[ObsInputs], np.ndarray] | None = field(default=None, compare=False)
+    value: Callable[[ObsInputs], Array] | None = field(default=None, compare=False)
 
 
 @dataclass
@@ -35,17 +38,17 @@ class ObsInputs:
     """What observation terms read: the robot state and the task's signals of this step."""
 
     state: RobotState
-    default_joint_pos: np.ndarray
-    command: np.ndarray  # (N, 3)
-    action: np.ndarray  # (N, J)
-    phase: np.ndarray  # (N, 2)
-    standing: np.ndarray  # (N,) bool
+    default_joint_pos: Array
+    command: Array  # (N, 3)
+    action: Array  # (N, J)
+    phase: Array  # (N, 2)
+    standing: Array  # (N,) bool
 
 
 @dataclass(frozen=True)
 class ObsTerm:
     dim: Callable[[int], int]  # of the joint count
-    value: Callable[[ObsInputs], np.ndarray]  # (N, dim), raw (before noise and scale)
+    value: Callable[[ObsInputs], Array]  # (N, dim), raw (before noise and scale)
 
 
 def terms(declared, num_joints: int) -> tuple[Term, ...]:
@@ -68,49 +71,56 @@ def current_terms(obs_cfg, num_joints: int) -> tuple[Term, ...]:
     return terms(obs_cfg.current, num_joints)
 
 
-def build(
-    inputs: ObsInputs, declared: tuple[Term, ...], rng: np.random.Generator | None
-) -> np.ndarray:
+def build(inputs: ObsInputs, declared: tuple[Term, ...], rng: Any | None) -> Array:
     """(N, D): each term's raw value, plus noise (unless `rng` is None: the critic's clean
-    version), times its scale, clipped; noise before scale, as IsaacLab does."""
+    version), times its scale, clipped; noise before scale, as IsaacLab does. `rng`: a NumPy
+    Generator for NumPy arrays, a torch.Generator on the tensors' device for torch."""
     parts = []
     for term in declared:
         value = term.value(inputs)
+        xp = namespace(value)
         if rng is not None and term.noise > 0:
-            value = value + rng.uniform(-term.noise, term.noise, value.shape)
-        value = value * np.asarray(term.scale)
+            value = value + uniform(rng, term.noise, value)
+        value = value * like(term.scale, value)
         if term.clip is not None:
-            value = np.clip(value, -term.clip, term.clip)
+            value = xp.clip(value, min=-term.clip, max=term.clip)
         parts.append(value)
-    return np.concatenate(parts, axis=1)
+    return namespace(*parts).concat(parts, axis=1)
 
 
-def phase_features(phase: np.ndarray, standing: np.ndarray) -> np.ndarray:
+def phase_features(phase: Array, standing: Array) -> Array:
     """(N, 2) sin/cos of the left foot's phase; zero while standing (standing detection)."""
-    angle = 2 * np.pi * phase[:, 0]
-    feats = np.stack([np.sin(angle), np.cos(angle)], axis=1)
+    xp = namespace(phase)
+    angle = 2 * xp.pi * phase[:, 0]
+    feats = xp.stack([xp.sin(angle), xp.cos(angle)], axis=1)
     return feats * (~standing)[:, None]
 
 
 class History:
-    """(N, K, D) buffer, index 0 newest. A reset env's history is filled with its first frame."""
+    """(N, K, D) buffer, index 0 newest. A reset env's history is filled with its first frame.
+    `reference` gives the array type, dtype and device (default: NumPy float64)."""
 
-    def __init__(self, num_envs: int, length: int, dim: int):
-        self.buffer = np.zeros((num_envs, length, dim))
+    def __init__(self, num_envs: int, length: int, dim: int, reference: Array | None = None):
+        reference = np.zeros(0) if reference is None else reference
+        xp = namespace(reference)
+        self.buffer = xp.zeros(
+            (num_envs, length, dim), dtype=reference.dtype, device=device_of(reference)
+        )
 
-    def push(self, frame: np.ndarray) -> None:
-        self.buffer[:, 1:] = self.buffer[:, :-1]
-        self.buffer[:, 0] = frame
+    def push(self, frame: Array) -> None:
+        xp = namespace(frame)
+        # a new buffer, not an overlapping in-place shift, which torch does not allow
+        self.buffer = xp.concat([frame[:, None, :], self.buffer[:, :-1]], axis=1)
 
-    def fill(self, ids: np.ndarray, frame: np.ndarray) -> None:
+    def fill(self, ids: Array, frame: Array) -> None:
         self.buffer[ids] = frame[ids, None, :]
 
-    def flat(self) -> np.ndarray:
+    def flat(self) -> Array:
         """(N, K*D), term-major within each frame, newest frame first."""
-        return self.buffer.reshape(self.buffer.shape[0], -1)
+        return namespace(self.buffer).reshape(self.buffer, (self.buffer.shape[0], -1))
 
 
-def _register(name: str, dim: Callable[[int], int], value: Callable[[ObsInputs], np.ndarray]):
+def _register(name: str, dim: Callable[[int], int], value: Callable[[ObsInputs], Array]):
     OBS_TERMS.register(name)(ObsTerm(dim, value))
 
 

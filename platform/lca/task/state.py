@@ -1,4 +1,5 @@
-"""What the task reads from the simulation each policy step, as plain numpy arrays.
+"""What the task reads from the simulation each policy step: NumPy arrays from mjbatch (the
+terms that read it run on torch tensors too, lca.arrays).
 
 Contact quantities are maxima over the physics substeps of one policy step, so a short
 impact between two policy steps still counts.
@@ -10,54 +11,54 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lca.arrays import Array, namespace
 from lca.sim import robot as g1
 from lca.sim.batch import BatchedSim
 
 
-def quat_to_mat(q: np.ndarray) -> np.ndarray:
+def quat_to_mat(q: Array) -> Array:
     """(..., 4) wxyz -> (..., 3, 3)."""
-    w, x, y, z = np.moveaxis(q, -1, 0)
-    return np.stack(
-        [
-            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
-        ],
-        -2,
+    xp = namespace(q)
+    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    rows = (
+        (1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)),
+        (2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)),
+        (2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)),
     )
+    return xp.stack([xp.stack(row, axis=-1) for row in rows], axis=-2)
 
 
-def yaw_of(q: np.ndarray) -> np.ndarray:
-    w, x, y, z = np.moveaxis(q, -1, 0)
-    return np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+def yaw_of(q: Array) -> Array:
+    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    return namespace(q).atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
 
 
-def pitch_of(q: np.ndarray) -> np.ndarray:
+def pitch_of(q: Array) -> Array:
     """Pitch (rad) of a frame's x-axis out of the horizontal plane."""
-    m = quat_to_mat(q)
-    return np.arctan2(-m[..., 2, 0], np.hypot(m[..., 0, 0], m[..., 1, 0]))
+    xp, m = namespace(q), quat_to_mat(q)
+    return xp.atan2(-m[..., 2, 0], xp.hypot(m[..., 0, 0], m[..., 1, 0]))
 
 
 @dataclass
 class RobotState:
-    base_pos: np.ndarray  # (N, 3) world
-    base_quat: np.ndarray  # (N, 4) wxyz
-    base_lin_vel: np.ndarray  # (N, 3) body frame
-    base_lin_vel_world: np.ndarray  # (N, 3) world frame (critic, as in the paper)
-    base_ang_vel: np.ndarray  # (N, 3) body frame
-    projected_gravity: np.ndarray  # (N, 3) unit gravity in the body frame
-    base_height: np.ndarray  # (N,) above the terrain under the base
-    joint_pos: np.ndarray  # (N, J)
-    joint_vel: np.ndarray  # (N, J)
-    joint_acc: np.ndarray  # (N, J)
-    torque: np.ndarray  # (N, J) actuator torques
-    foot_pos: np.ndarray  # (N, 2, 3) sole sites, left then right
-    foot_vel: np.ndarray  # (N, 2, 3) world
-    foot_pitch: np.ndarray  # (N, 2)
-    foot_height: np.ndarray  # (N, 2) above the terrain under each sole
-    foot_force: np.ndarray  # (N, 2) max over substeps of |ground reaction|
-    foot_lateral_force: np.ndarray  # (N, 2) max over substeps of |F_xy|
-    leg_contact_force: np.ndarray  # (N, B) max over substeps, undesired leg bodies
+    base_pos: Array  # (N, 3) world
+    base_quat: Array  # (N, 4) wxyz
+    base_lin_vel: Array  # (N, 3) body frame
+    base_lin_vel_world: Array  # (N, 3) world frame (critic, as in the paper)
+    base_ang_vel: Array  # (N, 3) body frame
+    projected_gravity: Array  # (N, 3) unit gravity in the body frame
+    base_height: Array  # (N,) above the terrain under the base
+    joint_pos: Array  # (N, J)
+    joint_vel: Array  # (N, J)
+    joint_acc: Array  # (N, J)
+    torque: Array  # (N, J) actuator torques
+    foot_pos: Array  # (N, 2, 3) sole sites, left then right
+    foot_vel: Array  # (N, 2, 3) world
+    foot_pitch: Array  # (N, 2)
+    foot_height: Array  # (N, 2) above the terrain under each sole
+    foot_force: Array  # (N, 2) max over substeps of |ground reaction|
+    foot_lateral_force: Array  # (N, 2) max over substeps of |F_xy|
+    leg_contact_force: Array  # (N, B) max over substeps, undesired leg bodies
 
 
 class ContactAccumulator:

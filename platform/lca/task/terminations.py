@@ -2,23 +2,27 @@
 
 from __future__ import annotations
 
-import numpy as np
+import math
 
+from lca.arrays import Array, device_of, namespace
 from lca.task.config import TerminationConfig
 from lca.task.state import RobotState
 
 
-def fell(state: RobotState, cfg: TerminationConfig) -> np.ndarray:
+def fell(state: RobotState, cfg: TerminationConfig) -> Array:
     # projected gravity z = -cos(tilt)
-    tilted = -state.projected_gravity[:, 2] < np.cos(cfg.max_tilt)
+    tilted = -state.projected_gravity[:, 2] < math.cos(cfg.max_tilt)
     return (state.base_height < cfg.min_base_height) | tilted
 
 
-def non_finite(state: RobotState, max_joint_vel: float) -> np.ndarray:
-    bad = np.zeros(len(state.base_pos), dtype=bool)
+def non_finite(state: RobotState, max_joint_vel: float) -> Array:
+    xp, n = namespace(state.base_pos), state.base_pos.shape[0]
+    bad = xp.zeros(n, dtype=xp.bool, device=device_of(state.base_pos))
     for value in vars(state).values():
-        bad |= ~np.isfinite(value.reshape(len(bad), -1)).all(axis=1)
-    return bad | (np.abs(np.nan_to_num(state.joint_vel, nan=0.0)) > max_joint_vel).any(axis=1)
+        bad = bad | ~xp.all(xp.isfinite(xp.reshape(value, (n, -1))), axis=1)
+    vel = state.joint_vel
+    fast = xp.any(xp.abs(xp.where(xp.isnan(vel), 0.0, vel)) > max_joint_vel, axis=1)
+    return bad | fast
 
 
 TERMINATIONS = ("fall", "time_out", "non_finite")
