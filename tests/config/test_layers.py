@@ -13,7 +13,14 @@ import lca
 
 PACKAGE = Path(lca.__file__).resolve().parent
 ORDER = ["config", "sim", "task", "learn", "evaluate", "report"]
-BASE = {"lca", "lca.paths", "lca.cli", "lca.store", "lca.testhook"}  # what every stage may use
+BASE = {
+    "lca",
+    "lca.arrays",
+    "lca.paths",
+    "lca.cli",
+    "lca.store",
+    "lca.testhook",
+}  # what every stage may use
 # evaluation loads a policy from its run directory's files (train_cfg.json, final_<stage>.pt),
 # never from the learning stage's code
 SKIPPED = {"evaluate": {"learn"}}

@@ -193,3 +193,33 @@ def test_a_boost_multiplies_its_term_only():
     boosted, terms = compute_rewards(ctx, weights, dt=1.0, boosts={"alive": 3.0})
     np.testing.assert_allclose(terms["alive"], [0.45, 0.0])
     np.testing.assert_allclose(boosted - plain, [0.30, 0.0])
+
+
+def test_a_boost_window_applies_late_and_ends_on_the_paper_weights():
+    cfg = RewardCurriculumConfig(
+        enabled=True,
+        by="iterations",
+        deadline=0.5,
+        boost={"track_lin_vel_xy_exp": 3.0},
+        boost_window=[0.6, 0.8],
+    )
+    c = RewardCurriculum(cfg, total_iterations=100)
+    c.update(10, 0.0)
+    assert c.boosts == {} and not c.done  # the penalties still ramp; no boost before 60
+    c.update(55, 0.0)
+    assert c.done  # the table's weights between the deadline and the window
+    c.update(60, 0.0)
+    assert c.boosts == {"track_lin_vel_xy_exp": 3.0} and not c.done
+    c.update(70, 0.0)
+    assert c.boosts["track_lin_vel_xy_exp"] == pytest.approx(2.0)
+    c.update(80, 0.0)
+    assert c.done and c.shaping == (1.0, False, {})  # and so to the end
+    c.update(99, 0.0)
+    assert c.done
+
+
+@pytest.mark.parametrize("window", [[0.5], [0.8, 0.6], [0.6, 1.0], [-0.1, 0.5]])
+def test_a_boost_window_must_end_before_the_run(window):
+    cfg = RewardCurriculumConfig(enabled=True, boost_window=window)
+    with pytest.raises(ValueError, match="boost_window"):
+        cfg.check()

@@ -27,6 +27,7 @@ class RewardCurriculum:
         self.step = (1.0 - cfg.penalty_start) / max(cfg.ramp * total_iterations, 1.0)
         start = cfg.penalty_start if cfg.enabled else 1.0
         self.scale = float(start if scale is None else scale)
+        self.iteration = 0
 
     def target(self, iteration: int, episode_fraction: float) -> float:
         """Scale asked for by the mean episode length (fraction of the maximum) or, with
@@ -46,6 +47,7 @@ class RewardCurriculum:
         """The scale for `iteration`, given the latest mean episode length fraction and, for
         `by: tracking`, the tracking progress 1 - |u - v| / |u| of the last rollout."""
         c = self.cfg
+        self.iteration = iteration
         if not c.enabled or iteration >= self.deadline:
             self.scale = 1.0
         elif c.by == "tracking":
@@ -77,17 +79,26 @@ class RewardCurriculum:
 
     @property
     def done(self) -> bool:
-        """True once the objective is the paper's: full penalties, no clipping."""
-        return self.scale >= 1.0 and not self.only_positive
+        """True once the objective is the paper's: full penalties, no clipping, no boost."""
+        return self.scale >= 1.0 and not self.only_positive and not self.boosts
 
     @property
     def boosts(self) -> dict[str, float]:
-        """Factors on the boosted terms' weights: the configured ones at the start, 1 (none
-        left) once the penalties are the table's."""
-        if not self.cfg.enabled or self.done:
+        """Factors on the boosted terms' weights: the configured ones at the start (of the
+        window, if any), 1 (none left) once the penalties are the table's (at its end)."""
+        c = self.cfg
+        if not c.enabled or not c.boost:
             return {}
-        left = 1.0 - self.progress
-        return {k: 1.0 + (float(f) - 1.0) * left for k, f in self.cfg.boost.items()}
+        if c.boost_window:
+            start, end = (math.ceil(f * self.total) for f in c.boost_window)
+            if not start <= self.iteration < end:
+                return {}
+            left = 1.0 - (self.iteration - start) / max(end - start, 1)
+        elif self.scale >= 1.0 and not self.only_positive:
+            return {}
+        else:
+            left = 1.0 - self.progress
+        return {k: 1.0 + (float(f) - 1.0) * left for k, f in c.boost.items()}
 
     @property
     def shaping(self) -> tuple[float, bool, dict[str, float]]:

@@ -109,6 +109,10 @@ class RewardCurriculumConfig:
     # term -> factor on its weight at the start, falling linearly to 1 as the penalties reach
     # the table's (e.g. {phase_contact: 4}: step with the gait clock before anything else)
     boost: dict[str, float] = field(default_factory=dict)
+    # [start, end] fractions of max_iterations: the boosts apply from `start` and fall linearly
+    # to 1 at `end` instead (e.g. [0.8, 0.9]: speed up a gait formed under the table's weights).
+    # []: from the first iteration until the penalties are the table's
+    boost_window: list[float] = field(default_factory=list)
     # terms added after the clip, like the termination penalty: their gradient reaches the
     # policy even while the clipped sum is negative (e.g. the posture terms, so that the
     # posture forms with the gait instead of after it)
@@ -135,6 +139,13 @@ class RewardCurriculumConfig:
         for part in ("terms", "unclipped"):
             for name in getattr(self, part):
                 REWARD_TERMS.check(name, f"{key}.{part}")
+        window = self.boost_window
+        require(
+            not window or (len(window) == 2 and 0 <= window[0] < window[1] < 1),
+            f"{key}.boost_window",
+            f"need [start, end] with 0 <= start < end < 1 (the run ends on the table's "
+            f"weights), got {list(window)}",
+        )
         for name, factor in self.boost.items():
             REWARD_TERMS.check(name, f"{key}.boost.{name}")
             require(factor > 0, f"{key}.boost.{name}", f"must be > 0, got {factor}")

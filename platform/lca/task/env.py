@@ -198,6 +198,8 @@ class LocomotionEnv(VecEnv):
         extras["log"]["Curriculum/penalty_scale"] = self.penalty_scale
         extras["log"]["Curriculum/only_positive"] = float(self.only_positive)
         extras["log"]["Curriculum/command_floor"] = self.commands.min_speed
+        for name, factor in self.boosts.items():
+            extras["log"][f"Curriculum/boost_{name}"] = factor
         self._reset_envs(done_ids)
         if done_ids.size:
             state = replace_rows(state, read_state(self.sim, self.contacts, done_ids), done_ids)

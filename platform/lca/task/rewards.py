@@ -177,11 +177,11 @@ def dof_pos_limits(c: RewardContext) -> Array:
 
 
 def alive(c: RewardContext) -> Array:
-    return as_float(~c.terminated, c.state.base_pos)
+    return as_float(~c.terminated, c.command)
 
 
 def termination_penalty(c: RewardContext) -> Array:
-    return as_float(c.terminated, c.state.base_pos)
+    return as_float(c.terminated, c.command)
 
 
 # The table's terms, registered by name (lca.config.registry); a plugin adds its own the
@@ -253,16 +253,17 @@ def compute_rewards(
     before adding that penalty: while a young policy's penalties outweigh its rewards, living
     longer would otherwise cost more than falling early. The `unclipped` terms are added
     after the clip too, so their gradient reaches the policy whatever the clipped sum."""
-    terms, xp = {}, ctx.xp
+    terms = {}
     params, boosts = params or {}, boosts or {}
     fns = fns or {name: REWARD_TERMS[name] for name in weights}
     for name, weight in weights.items():
         value = weight * boosts.get(name, 1.0) * fns[name](ctx, **params.get(name, {})) * dt
         if penalty_scale != 1.0 and (scaled_terms is None or name in scaled_terms):
-            value = xp.where(value < 0, penalty_scale * value, value)
+            value = namespace(value).where(value < 0, penalty_scale * value, value)
         terms[name] = value
     after_clip = unclipped | {"termination_penalty"} if only_positive else frozenset()
-    total = outside = xp.zeros_like(ctx.state.base_height)
+    xp = namespace(ctx.command)
+    total = outside = xp.zeros(ctx.command.shape[0], dtype=ctx.command.dtype)
     for name, value in terms.items():
         if name in after_clip:
             outside = outside + value
