@@ -24,11 +24,12 @@ LEVERS: dict[str, tuple[str, list[str]]] = {
     "recipe": ("the scale=cpu defaults", []),
     "before": (
         "the defaults before the recipe: one action scale 0.25, always only_positive, "
-        "no reward curriculum",
+        "no reward or command curriculum",
         [
             "task.action_scale_by_effort=false",
             "task.only_positive_rewards=true",
             "task.reward_curriculum.enabled=false",
+            "task.command_curriculum.enabled=false",
         ],
     ),
     "no_curriculum": ("paper penalties from the start", ["task.reward_curriculum.enabled=false"]),
@@ -41,26 +42,20 @@ LEVERS: dict[str, tuple[str, list[str]]] = {
         ["robot=g1_isaaclab", "task.action_scale_by_effort=false", "task.action_scale=0.5"],
     ),
     "one_action_scale": ("one action scale 0.25", ["task.action_scale_by_effort=false"]),
-    "forward_first": (
-        "commands forward only (0.3-0.6 m/s), widening to the full range by 60 %",
-        [
-            "task.command_curriculum.enabled=true",
-            "task.command_curriculum.min_speed=0",
-            "task.command_curriculum.widen_from.lin_vel_x=[0.3,0.6]",
-            "task.command_curriculum.widen_from.lin_vel_y=[0,0]",
-            "task.command_curriculum.widen_from.ang_vel_z=[0,0]",
-            "task.command_curriculum.widen_from.standing_fraction=0",
-        ],
+    "all_commands": (
+        "the paper's command ranges from the start (no forward-only phase)",
+        ["task.command_curriculum.enabled=false"],
     ),
-    "posture_unclipped": (
-        "posture terms added after the clip (their gradient always reaches the policy)",
-        [
-            "task.reward_curriculum.unclipped=[joint_deviation_hip,joint_deviation_arms,"
-            "joint_deviation_torso,feet_flat,flat_orientation_l2,height_torso]"
-        ],
+    "posture_clipped": (
+        "posture terms inside the clip, like every other penalty",
+        ["task.reward_curriculum.unclipped=[]"],
+    ),
+    "no_late_boost": (
+        "no late tracking boost (factor 1)",
+        ["task.reward_curriculum.boost.track_lin_vel_xy_exp=1.0"],
     ),
     "init_noise_0.5": ("initial action std 0.5", ["actor.init_noise_std=0.5"]),
-    "symmetry": ("mirror augmentation", ["algo.symmetry=true"]),
+    "no_symmetry": ("no mirror augmentation", ["algo.symmetry=false"]),
     "fixed_lr": ("fixed learning rate 3e-4", ["algo.schedule=fixed", "algo.learning_rate=3e-4"]),
     "envs_512x12": (
         "512 envs x 12 steps",
