@@ -223,3 +223,23 @@ def test_a_boost_window_must_end_before_the_run(window):
     cfg = RewardCurriculumConfig(enabled=True, boost_window=window)
     with pytest.raises(ValueError, match="boost_window"):
         cfg.check()
+
+
+@pytest.mark.parametrize("iterations", [30, 2450])
+def test_the_default_recipe_ends_on_the_paper_objective(iterations):
+    """scale=cpu's curricula (the walk recipe): every device has ended before the run does,
+    and from then on the env gets the table's weights, unclipped, unboosted."""
+    from omegaconf import OmegaConf
+
+    from lca.config import compose
+
+    task = OmegaConf.to_object(compose([f"scale.max_iterations={iterations}"]).task)
+    rewards = RewardCurriculum(task.reward_curriculum, iterations)
+    commands = CommandCurriculum(task.command_curriculum, iterations)
+    shaping = []
+    for it in range(iterations):
+        rewards.update(it, 0.0)
+        shaping.append((rewards.shaping, rewards.done, commands.ranges(it, task.commands)))
+    assert shaping[0][1] is False and any(s[0][2] for s in shaping)  # devices were on
+    end = int(0.9 * iterations)
+    assert all(s == ((1.0, False, {}), True, {}) for s in shaping[end:])
