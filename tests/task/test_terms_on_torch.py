@@ -20,6 +20,8 @@ from lca.task.state import RobotState
 from tests.task.conftest import MIXED
 
 STEPS = 12
+# the tensors' device: cpu, and cuda where a GPU exists (.ci/gpu_check runs these there)
+DEVICE = torch.device("cuda" if torch.cuda.is_available() else "cpu")
 # float64 tensors must match NumPy to rounding; float32 (a GPU's dtype) to its precision
 TOLERANCES = {
     torch.float64: dict(rtol=1e-10, atol=1e-12),
@@ -30,7 +32,7 @@ TOLERANCES = {
 def to_torch(value, dtype: torch.dtype):
     """NumPy fields (nested dataclasses too) as torch tensors; floats as `dtype`."""
     if isinstance(value, np.ndarray):
-        tensor = torch.from_numpy(np.array(value))
+        tensor = torch.from_numpy(np.array(value)).to(DEVICE)
         return tensor.to(dtype) if tensor.is_floating_point() else tensor
     if dataclasses.is_dataclass(value) and isinstance(value, RobotState):
         return RobotState(**{k: to_torch(v, dtype) for k, v in vars(value).items()})
@@ -43,8 +45,8 @@ def torch_copy(obj, dtype: torch.dtype):
 
 
 def close(torch_value: torch.Tensor, numpy_value: np.ndarray, dtype: torch.dtype) -> None:
-    assert isinstance(torch_value, torch.Tensor)
-    np.testing.assert_allclose(torch_value.double().numpy(), numpy_value, **TOLERANCES[dtype])
+    assert isinstance(torch_value, torch.Tensor) and torch_value.device.type == DEVICE.type
+    np.testing.assert_allclose(torch_value.double().cpu().numpy(), numpy_value, **TOLERANCES[dtype])
 
 
 @pytest.fixture(scope="module")
@@ -97,11 +99,11 @@ def test_observation_groups_and_history_agree(stepped, dtype):
             dtype,
         )
     clean = observations.build(tinputs, env.history_terms, None)
-    noisy = observations.build(tinputs, env.history_terms, torch.Generator().manual_seed(1))
+    noisy = observations.build(tinputs, env.history_terms, torch.Generator(DEVICE).manual_seed(1))
     bound = np.concatenate(
         [np.full(t.dim, t.noise) * np.abs(np.asarray(t.scale)) for t in env.history_terms]
     )
-    diff = (noisy - clean).abs().double().numpy()
+    diff = (noisy - clean).abs().double().cpu().numpy()
     assert (diff <= bound * (1 + 1e-6) + 1e-6).all() and diff.max() > 0
 
     frames = [observations.build(inputs, env.history_terms, None) * k for k in (1, 2, 3)]
@@ -112,7 +114,7 @@ def test_observation_groups_and_history_agree(stepped, dtype):
         numpy_h.push(frame)
         torch_h.push(to_torch(frame, dtype))
     numpy_h.fill(ids, frames[0])
-    torch_h.fill(torch.from_numpy(ids), to_torch(frames[0], dtype))
+    torch_h.fill(to_torch(ids, dtype), to_torch(frames[0], dtype))
     close(torch_h.flat(), numpy_h.flat(), dtype)
     np.testing.assert_array_equal(numpy_h.buffer[1, 0], frames[2][1])  # newest first
 
@@ -130,7 +132,7 @@ def test_terminations_agree(stepped):
         (terminations.fell(state, cfg), terminations.fell(tstate, cfg)),
         (terminations.non_finite(state, 1e3), terminations.non_finite(tstate, 1e3)),
     ):
-        np.testing.assert_array_equal(torch_value.numpy(), numpy_value)
+        np.testing.assert_array_equal(torch_value.cpu().numpy(), numpy_value)
     assert terminations.non_finite(state, 1e3)[[1, 2, 4]].all()
 
 
@@ -147,19 +149,19 @@ def test_height_query_and_maps_agree(stepped, dtype):
     assert np.ptp(heights) > 0.05  # stairs and blocks, not only flat ground
     tol = TOLERANCES[dtype] if dtype == torch.float64 else dict(rtol=0, atol=1e-4)
     got = terrain.height_at(to_torch(x, dtype), to_torch(y, dtype))
-    np.testing.assert_allclose(got.double().numpy(), heights, **tol)
+    np.testing.assert_allclose(got.double().cpu().numpy(), heights, **tol)
 
     xy, yaw = ctx.state.base_pos[:, :2], rng.uniform(-np.pi, np.pi, env.num_envs)
     sampled = heightmap.sample_heights(terrain, xy, yaw, env.critic_offsets)
     tsampled = heightmap.sample_heights(
         terrain, to_torch(xy, dtype), to_torch(yaw, dtype), env.critic_offsets
     )
-    np.testing.assert_allclose(tsampled.double().numpy(), sampled, **tol)
+    np.testing.assert_allclose(tsampled.double().cpu().numpy(), sampled, **tol)
     valid = rng.random(sampled.shape) > 0.3
     for mask in (None, valid):
         close(
-            heightmap.normalise(tsampled, None if mask is None else torch.from_numpy(mask)),
-            heightmap.normalise(tsampled.double().numpy(), mask),
+            heightmap.normalise(tsampled, None if mask is None else to_torch(mask, dtype)),
+            heightmap.normalise(tsampled.double().cpu().numpy(), mask),
             dtype,
         )
 

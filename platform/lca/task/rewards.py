@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from lca.arrays import Array, as_float, namespace
+from lca.arrays import Array, as_float, device_of, namespace
 from lca.config.registry import REWARD_TERMS
 from lca.sim.batch import BatchedSim
 from lca.task.config import RewardParams
@@ -263,7 +263,9 @@ def compute_rewards(
         terms[name] = value
     after_clip = unclipped | {"termination_penalty"} if only_positive else frozenset()
     xp = namespace(ctx.command)
-    total = outside = xp.zeros(ctx.command.shape[0], dtype=ctx.command.dtype)
+    total = outside = xp.zeros(
+        ctx.command.shape[0], dtype=ctx.command.dtype, device=device_of(ctx.command)
+    )
     for name, value in terms.items():
         if name in after_clip:
             outside = outside + value
