@@ -16,7 +16,7 @@ from lca.task import heightmap, observations, rewards, terminations
 from lca.task.commands import gait_phase
 from lca.task.config import TerminationConfig
 from lca.task.rewards import compute_rewards
-from lca.task.state import RobotState
+from lca.task.state import ContactAccumulator, RobotState, read_state
 from tests.task.conftest import MIXED
 
 STEPS = 12
@@ -174,3 +174,49 @@ def test_gait_clock_agrees(stepped):
     assert phase.min() >= 0 and phase.max() < 1 and np.ptp(phase[:, 0]) > 0
     for dtype in TOLERANCES:
         close(gait_phase(to_torch(time, dtype), period), phase, dtype)
+
+
+class TorchViews:
+    """The sim's live arrays as torch tensors (zero-copy on the CPU, as `wp.to_torch` gives
+    them for warp's arrays), for what the state reader uses."""
+
+    def __init__(self, sim):
+        self.sim, self.num_envs, self.scene = sim, sim.num_envs, sim.scene
+        self.joint_qpos, self.joint_dof = sim.joint_qpos, sim.joint_dof
+
+    def _view(self, array: np.ndarray) -> torch.Tensor:
+        return torch.from_numpy(array).to(DEVICE)
+
+    def sensor(self, name: str) -> torch.Tensor:
+        return self._view(self.sim.sensor(name))
+
+    def __getattr__(self, name: str) -> torch.Tensor:  # qpos, qvel, qacc, actuator_force
+        return self._view(getattr(self.sim, name))
+
+
+def test_state_and_contact_maxima_read_from_torch_views_agree(stepped):
+    env, _ = stepped
+    views = TorchViews(env.sim)
+    contacts = ContactAccumulator(env.sim)
+    tcontacts = ContactAccumulator(views)
+    assert isinstance(tcontacts.foot_force, torch.Tensor)
+    for _ in range(3):
+        env.sim.step()
+        contacts.update()
+        if DEVICE.type == "cuda":  # copies, not views: the sensors as they are now
+            tcontacts = replace_sensors(tcontacts, views)
+        tcontacts.update()
+    assert contacts.foot_force.max() > 0  # feet on the ground
+    ids = np.array([1, 4, 6])
+    for rows in (None, ids):
+        state = read_state(env.sim, contacts, rows)
+        tstate = read_state(views, tcontacts, None if rows is None else to_torch(rows, None))
+        for name, value in vars(state).items():
+            close(getattr(tstate, name), value, torch.float64)
+
+
+def replace_sensors(contacts: ContactAccumulator, views: TorchViews) -> ContactAccumulator:
+    fresh = ContactAccumulator(views)
+    fresh.foot_force, fresh.foot_lateral = contacts.foot_force, contacts.foot_lateral
+    fresh.leg_force = contacts.leg_force
+    return fresh

@@ -1,5 +1,5 @@
-"""What the task reads from the simulation each policy step: NumPy arrays from mjbatch (the
-terms that read it run on torch tensors too, lca.arrays).
+"""What the task reads from the simulation each policy step, in the sim's array type: NumPy
+for mjbatch, torch tensors for views of warp's arrays (lca.arrays).
 
 Contact quantities are maxima over the physics substeps of one policy step, so a short
 impact between two policy steps still counts.
@@ -9,9 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
-
-from lca.arrays import Array, namespace
+from lca.arrays import Array, device_of, namespace
 from lca.sim import robot as g1
 from lca.sim.batch import BatchedSim
 
@@ -62,7 +60,8 @@ class RobotState:
 
 
 class ContactAccumulator:
-    """Tracks contact-force maxima over the substeps of one policy step."""
+    """Tracks contact-force maxima over the substeps of one policy step, in the sim's array
+    type (NumPy for mjbatch, torch for views of warp's arrays)."""
 
     def __init__(self, sim: BatchedSim):
         self.sim = sim
@@ -72,10 +71,14 @@ class ContactAccumulator:
             for side in g1.FEET
             for part in g1.UNDESIRED_CONTACT_BODIES
         ]
-        n = sim.num_envs
-        self.foot_force = np.zeros((n, 2))
-        self.foot_lateral = np.zeros((n, 2))
-        self.leg_force = np.zeros((n, len(self.legs)))
+        xp, n, reference = namespace(sim.qpos), sim.num_envs, sim.qpos
+
+        def zeros(width: int) -> Array:
+            return xp.zeros((n, width), dtype=reference.dtype, device=device_of(reference))
+
+        self.foot_force = zeros(2)
+        self.foot_lateral = zeros(2)
+        self.leg_force = zeros(len(self.legs))
 
     def clear(self) -> None:
         self.foot_force[:] = 0
@@ -83,55 +86,60 @@ class ContactAccumulator:
         self.leg_force[:] = 0
 
     def update(self) -> None:
+        xp = namespace(self.foot_force)
+        norm = xp.linalg.vector_norm
         for i, sensor in enumerate(self.feet):
             force = sensor[:, 1:4]
-            np.maximum(
-                self.foot_force[:, i], np.linalg.norm(force, axis=1), out=self.foot_force[:, i]
-            )
-            lateral = np.linalg.norm(force[:, :2], axis=1)
-            np.maximum(self.foot_lateral[:, i], lateral, out=self.foot_lateral[:, i])
+            self.foot_force[:, i] = xp.maximum(self.foot_force[:, i], norm(force, axis=1))
+            lateral = norm(force[:, :2], axis=1)
+            self.foot_lateral[:, i] = xp.maximum(self.foot_lateral[:, i], lateral)
         for i, sensor in enumerate(self.legs):
-            force = np.linalg.norm(sensor[:, 1:4], axis=1)
-            np.maximum(self.leg_force[:, i], force, out=self.leg_force[:, i])
+            force = norm(sensor[:, 1:4], axis=1)
+            self.leg_force[:, i] = xp.maximum(self.leg_force[:, i], force)
 
 
 def read_state(
-    sim: BatchedSim, contacts: ContactAccumulator, ids: np.ndarray | None = None
+    sim: BatchedSim, contacts: ContactAccumulator, ids: Array | None = None
 ) -> RobotState:
-    """The state of every env, or only of the rows `ids` (e.g. the envs just reset)."""
+    """The state of every env, or only of the rows `ids` (e.g. the envs just reset), as
+    copies in the sim's array type."""
     rows = slice(None) if ids is None else ids
     height_at = sim.scene.terrain.height_at
+    xp = namespace(sim.qpos)
 
-    def sensor(name: str) -> np.ndarray:
+    def copy(value: Array) -> Array:
+        return xp.asarray(value, copy=True)
+
+    def sensor(name: str) -> Array:
         return sim.sensor(name)[rows]  # fancy indexing copies; a slice does not
 
     qpos, qvel = sim.qpos[rows], sim.qvel[rows]
-    base_pos = np.array(qpos[:, :3])
-    foot_pos = np.stack([sensor(f"{s}_foot_pos") for s in g1.FEET], 1)
-    foot_quat = np.stack([sensor(f"{s}_foot_quat") for s in g1.FEET], 1)
+    base_pos = copy(qpos[:, :3])
+    foot_pos = xp.stack([sensor(f"{s}_foot_pos") for s in g1.FEET], axis=1)
+    foot_quat = xp.stack([sensor(f"{s}_foot_quat") for s in g1.FEET], axis=1)
     return RobotState(
         base_pos=base_pos,
-        base_quat=np.array(qpos[:, 3:7]),
-        base_lin_vel=np.array(sensor("imu_lin_vel")),
-        base_lin_vel_world=np.array(sensor("base_lin_vel_world")),
-        base_ang_vel=np.array(sensor("imu_ang_vel")),
+        base_quat=copy(qpos[:, 3:7]),
+        base_lin_vel=copy(sensor("imu_lin_vel")),
+        base_lin_vel_world=copy(sensor("base_lin_vel_world")),
+        base_ang_vel=copy(sensor("imu_ang_vel")),
         projected_gravity=-sensor("imu_up"),
         base_height=base_pos[:, 2] - height_at(base_pos[:, 0], base_pos[:, 1]),
-        joint_pos=np.array(qpos[:, sim.joint_qpos]),
-        joint_vel=np.array(qvel[:, sim.joint_dof]),
-        joint_acc=np.array(sim.qacc[rows][:, sim.joint_dof]),
-        torque=np.array(sim.actuator_force[rows]),
+        joint_pos=copy(qpos[:, sim.joint_qpos]),
+        joint_vel=copy(qvel[:, sim.joint_dof]),
+        joint_acc=copy(sim.qacc[rows][:, sim.joint_dof]),
+        torque=copy(sim.actuator_force[rows]),
         foot_pos=foot_pos,
-        foot_vel=np.stack([sensor(f"{s}_foot_lin_vel") for s in g1.FEET], 1),
+        foot_vel=xp.stack([sensor(f"{s}_foot_lin_vel") for s in g1.FEET], axis=1),
         foot_pitch=pitch_of(foot_quat),
         foot_height=foot_pos[..., 2] - height_at(foot_pos[..., 0], foot_pos[..., 1]),
-        foot_force=np.array(contacts.foot_force[rows]),
-        foot_lateral_force=np.array(contacts.foot_lateral[rows]),
-        leg_contact_force=np.array(contacts.leg_force[rows]),
+        foot_force=copy(contacts.foot_force[rows]),
+        foot_lateral_force=copy(contacts.foot_lateral[rows]),
+        leg_contact_force=copy(contacts.leg_force[rows]),
     )
 
 
-def zero_rows(state: RobotState, broken: np.ndarray) -> RobotState:
+def zero_rows(state: RobotState, broken: Array) -> RobotState:
     """Zero the rows of broken envs: `non_finite` flags every row holding a NaN or inf."""
     if broken.any():
         for value in vars(state).values():
@@ -139,7 +147,7 @@ def zero_rows(state: RobotState, broken: np.ndarray) -> RobotState:
     return state
 
 
-def replace_rows(state: RobotState, fresh: RobotState, ids: np.ndarray) -> RobotState:
+def replace_rows(state: RobotState, fresh: RobotState, ids: Array) -> RobotState:
     """Put `fresh` (the state of rows `ids` only) into `state`."""
     for name, value in vars(state).items():
         value[ids] = getattr(fresh, name)
