@@ -24,6 +24,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 from omegaconf import OmegaConf  # noqa: E402
 
@@ -209,6 +210,7 @@ def plot(evals: pd.DataFrame, out: Path) -> None:
             ax.plot(minutes, evals["still_cm_s"], marker="s", lw=1, label="zero command")
             ax.legend(fontsize=8)
         ax.axhline(limit, color="grey", ls="--", lw=1)
+        _mark_objective(ax, evals, minutes)
         ax.set_xlabel("training wall-clock (min, 2 CPU cores)")
         ax.set_title(label, fontsize=10)
         ax.grid(alpha=0.3)
@@ -220,15 +222,41 @@ def plot(evals: pd.DataFrame, out: Path) -> None:
             ),
         )
         top.set_xlabel("environment steps (M)", fontsize=8)
-    fig.suptitle("Time to walk: blind MLP, flat ground, scale=cpu", fontsize=11)
+    fig.suptitle(
+        "Time to walk: blind MLP, flat ground, scale=cpu (shaded: under the paper's objective)",
+        fontsize=11,
+    )
     fig.tight_layout()
     fig.savefig(out, dpi=120)
     plt.close(fig)
 
 
-def _interp(x, xp, fp):
-    import numpy as np
+def _mark_objective(ax, evals: pd.DataFrame, minutes: pd.Series) -> None:
+    """Shade the evaluations made under the paper's objective (the only ones that count) and
+    name the stages when the curve joins several runs (a `stage` column)."""
+    if "paper_objective" in evals:
+        paper = evals["paper_objective"].astype(bool).to_numpy()
+        block = (paper != np.roll(paper, 1)).cumsum()  # runs of equal values
+        for b in np.unique(block[paper]):
+            span = minutes[block == b]
+            ax.axvspan(span.min() - 1, span.max() + 1, color="tab:green", alpha=0.1, lw=0)
+    if "stage" in evals:
+        starts = evals.groupby("stage", sort=False).head(1).index
+        for i in starts[1:]:
+            ax.axvline(minutes[i], color="tab:purple", ls=":", lw=1)
+        for i in starts:
+            ax.annotate(
+                evals["stage"][i],
+                (minutes[i], 1.0),
+                xycoords=("data", "axes fraction"),
+                xytext=(2, -10),
+                textcoords="offset points",
+                fontsize=7,
+                color="tab:purple",
+            )
 
+
+def _interp(x, xp, fp):
     return np.interp(x, np.asarray(xp, float), np.asarray(fp, float))
 
 
