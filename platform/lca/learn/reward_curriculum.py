@@ -28,6 +28,12 @@ class RewardCurriculum:
         start = cfg.penalty_start if cfg.enabled else 1.0
         self.scale = float(start if scale is None else scale)
         self.iteration = 0
+        # the iterations [start, end) of a late boost window; None: boosts follow the penalties
+        self.boost_window = (
+            tuple(math.ceil(f * total_iterations) for f in cfg.boost_window)
+            if cfg.boost_window
+            else None
+        )
 
     def target(self, iteration: int, episode_fraction: float) -> float:
         """Scale asked for by the mean episode length (fraction of the maximum) or, with
@@ -89,8 +95,8 @@ class RewardCurriculum:
         c = self.cfg
         if not c.enabled or not c.boost:
             return {}
-        if c.boost_window:
-            start, end = (math.ceil(f * self.total) for f in c.boost_window)
+        if self.boost_window:
+            start, end = self.boost_window
             if not start <= self.iteration < end:
                 return {}
             left = 1.0 - (self.iteration - start) / max(end - start, 1)

@@ -71,10 +71,11 @@ class ContactAccumulator:
             for side in g1.FEET
             for part in g1.UNDESIRED_CONTACT_BODIES
         ]
-        xp, n, reference = namespace(sim.qpos), sim.num_envs, sim.qpos
+        self.xp = xp = namespace(sim.qpos)  # resolved once: update runs every substep
 
         def zeros(width: int) -> Array:
-            return xp.zeros((n, width), dtype=reference.dtype, device=device_of(reference))
+            shape, like = (sim.num_envs, width), sim.qpos
+            return xp.zeros(shape, dtype=like.dtype, device=device_of(like))
 
         self.foot_force = zeros(2)
         self.foot_lateral = zeros(2)
@@ -86,7 +87,7 @@ class ContactAccumulator:
         self.leg_force[:] = 0
 
     def update(self) -> None:
-        xp = namespace(self.foot_force)
+        xp = self.xp
         norm = xp.linalg.vector_norm
         for i, sensor in enumerate(self.feet):
             force = sensor[:, 1:4]
