@@ -39,14 +39,19 @@ def as_float(mask: Array, reference: Array) -> Array:
     return array_namespace(mask).astype(mask, reference.dtype)
 
 
-def uniform(rng: Any, half_width: float, reference: Array) -> Array:
-    """Uniform noise in [-half_width, half_width], shaped like `reference`: drawn from a
-    NumPy Generator for NumPy arrays, a torch.Generator on the tensor's device for torch."""
+def draw(rng: Any, low: float, high: float, shape: tuple, reference: Array) -> Array:
+    """Uniform samples in [low, high) of `shape`: from a NumPy Generator for NumPy arrays,
+    a torch.Generator on `reference`'s device (and in its dtype) for torch."""
     if isinstance(rng, np.random.Generator):
-        return rng.uniform(-half_width, half_width, reference.shape)
+        return rng.uniform(low, high, shape)
     import torch
 
-    unit = torch.rand(
-        reference.shape, generator=rng, dtype=reference.dtype, device=reference.device
-    )
-    return (2.0 * unit - 1.0) * half_width
+    unit = torch.rand(shape, generator=rng, dtype=reference.dtype, device=reference.device)
+    return low + (high - low) * unit
+
+
+def uniform(rng: Any, half_width: float, reference: Array) -> Array:
+    """Uniform noise in [-half_width, half_width], shaped like `reference` (see `draw`)."""
+    if isinstance(rng, np.random.Generator):
+        return rng.uniform(-half_width, half_width, reference.shape)
+    return draw(rng, -1.0, 1.0, tuple(reference.shape), reference) * half_width

@@ -21,6 +21,7 @@ def test_until_stops_a_probed_run_that_is_complete(tmp_path):
             "iterations=6",
             "until=3",
             "eval_every_s=0",
+            "eval_from=2",
             "eval.units=2",
             "eval.steps=20",
         ],
@@ -30,7 +31,8 @@ def test_until_stops_a_probed_run_that_is_complete(tmp_path):
     curve = pd.read_csv(run / "train_curve.csv")
     assert list(curve["iteration"]) == [0, 1, 2]  # stopped after `until` iterations of 6
     probes = pd.read_csv(run / "probe_evals.csv")
-    assert list(probes["iteration"]) == [0, 1, 2]  # every iteration probed (eval_every_s=0)
+    # every iteration probed (eval_every_s=0) from the second (iteration 1) on
+    assert list(probes["iteration"]) == [1, 2]
     assert set(probes["paper_objective"]) == {1}  # smoke: no curriculum, no clipping
     assert probes["still_cm_s"].notna().all()  # the zero-command probe ran each time
     assert (run / "COMPLETE").is_file() and (tmp_path / "walk.png").stat().st_size > 0

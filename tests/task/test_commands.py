@@ -74,3 +74,32 @@ def test_speed_floor_scales_slow_commands_up_and_keeps_their_direction():
     np.testing.assert_allclose(cross, 0.0, atol=1e-12)
     np.testing.assert_array_equal(floored.value[:, 2], free.value[:, 2])  # yaw rates kept
     assert floored.standing.mean() == pytest.approx(cfg.standing_fraction, abs=0.01)
+
+
+def test_commands_on_torch_tensors_follow_the_same_rules():
+    """sim.backend=warp keeps the commands on the physics device: torch buffers drawn from a
+    torch.Generator, with the same ranges, standing share, floor and resample clock."""
+    torch = pytest.importorskip("torch")
+    device = torch.device("cuda" if torch.cuda.is_available() else "cpu")
+    cfg = CommandConfig(resample_time_s=0.1)
+    n = 20000
+    gen = torch.Generator(device).manual_seed(0)
+    ref = torch.zeros(0, dtype=torch.float32, device=device)
+    cmd = VelocityCommand(cfg, n, dt=0.02, rng=gen, reference=ref)
+    cmd.min_speed = 0.3
+    cmd.resample(torch.arange(n, device=device))
+    v = cmd.value
+    assert isinstance(v, torch.Tensor) and v.dtype == torch.float32 and v.device == device
+    for k, (lo, hi) in enumerate([cfg.lin_vel_x, cfg.lin_vel_y, cfg.ang_vel_z]):
+        assert lo <= v[:, k].min() and v[:, k].max() <= hi
+    zero = (v == 0).all(dim=1)
+    assert zero.float().mean().item() == pytest.approx(cfg.standing_fraction, abs=0.01)
+    assert torch.equal(cmd.standing, torch.linalg.vector_norm(v, dim=1) < cfg.standing_epsilon)
+    assert torch.linalg.vector_norm(v[~zero, :2], dim=1).min() >= 0.3 - 1e-6  # the floor
+    first = v.clone()
+    for _ in range(4):  # 0.08 s: nothing due
+        cmd.update()
+    assert torch.equal(cmd.value, first)
+    for _ in range(2):  # 0.10 s: every command drawn again
+        cmd.update()
+    assert (cmd.value != first).any(dim=1).float().mean() > 0.95

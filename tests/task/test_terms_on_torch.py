@@ -17,6 +17,7 @@ from lca.task.commands import gait_phase
 from lca.task.config import TerminationConfig
 from lca.task.rewards import compute_rewards
 from lca.task.state import ContactAccumulator, RobotState, read_state
+from lca.task.step_metrics import step_metrics
 from tests.task.conftest import MIXED
 
 STEPS = 12
@@ -134,6 +135,21 @@ def test_terminations_agree(stepped):
     ):
         np.testing.assert_array_equal(torch_value.cpu().numpy(), numpy_value)
     assert terminations.non_finite(state, 1e3)[[1, 2, 4]].all()
+
+
+@pytest.mark.parametrize("dtype", [torch.float64, torch.float32])
+def test_step_metrics_agree(stepped, dtype):
+    _, ctx = stepped
+    time_out = np.arange(len(ctx.terminated)) % 4 == 1
+    args = (ctx.state, ctx.command, ctx.terminated, time_out)
+    metrics = step_metrics(*args, 100.0)
+    tmetrics = step_metrics(*(to_torch(a, dtype) for a in args), 100.0)
+    assert metrics.keys() == tmetrics.keys() and np.ptp(metrics["track_error"]) > 0
+    for name, value in metrics.items():
+        if value.dtype == bool:
+            np.testing.assert_array_equal(tmetrics[name].cpu().numpy(), value)
+        else:
+            close(tmetrics[name], value, dtype)
 
 
 @pytest.mark.parametrize("dtype", [torch.float64, torch.float32])

@@ -2,58 +2,72 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
-from lca.arrays import Array, namespace
+from lca.arrays import Array, device_of, draw, like, namespace
 from lca.task.config import CommandConfig
 
 
 class VelocityCommand:
     """u = (u_x, u_y, u_yaw) per env, resampled every `resample_time_s`; a configured share
-    of commands is exactly zero (standing)."""
+    of commands is exactly zero (standing). The buffers are arrays like `reference` (NumPy
+    float64 by default; torch tensors on the physics device, with a torch.Generator)."""
 
-    def __init__(self, cfg: CommandConfig, num_envs: int, dt: float, rng: np.random.Generator):
+    def __init__(
+        self,
+        cfg: CommandConfig,
+        num_envs: int,
+        dt: float,
+        rng: Any,
+        reference: Array | None = None,
+    ):
         self.cfg = cfg
         self.dt = dt
         self.rng = rng
-        self.value = np.zeros((num_envs, 3))
-        self.time_left = np.zeros(num_envs)
+        ref = np.zeros(0) if reference is None else reference
+        self.xp = namespace(ref)
+        self.value = self.xp.zeros((num_envs, 3), dtype=ref.dtype, device=device_of(ref))
+        self.time_left = self.xp.zeros(num_envs, dtype=ref.dtype, device=device_of(ref))
         self.min_speed = 0.0  # the command curriculum's floor on |u_xy| (0: off)
         self.ranges: dict = {}  # the command curriculum's ranges, in place of the config's
 
     @property
-    def standing(self) -> np.ndarray:
-        return np.linalg.norm(self.value, axis=1) < self.cfg.standing_epsilon
+    def standing(self) -> Array:
+        return self.xp.linalg.vector_norm(self.value, axis=1) < self.cfg.standing_epsilon
 
-    def resample(self, ids: np.ndarray) -> None:
-        n = len(ids)
+    def resample(self, ids: Array) -> None:
+        n = int(ids.shape[0])
         if n == 0:
             return
-        c = self.ranges
-        value = np.stack(
+        c, ref = self.ranges, self.value
+        value = self.xp.stack(
             [
-                self.rng.uniform(*c.get("lin_vel_x", self.cfg.lin_vel_x), n),
-                self.rng.uniform(*c.get("lin_vel_y", self.cfg.lin_vel_y), n),
-                self.rng.uniform(*c.get("ang_vel_z", self.cfg.ang_vel_z), n),
+                draw(self.rng, *c.get("lin_vel_x", self.cfg.lin_vel_x), n, ref),
+                draw(self.rng, *c.get("lin_vel_y", self.cfg.lin_vel_y), n, ref),
+                draw(self.rng, *c.get("ang_vel_z", self.cfg.ang_vel_z), n, ref),
             ],
             axis=1,
         )
         if self.min_speed > 0:
             value[:, :2] = _at_least(value[:, :2], self.min_speed)
-        value[self.rng.random(n) < c.get("standing_fraction", self.cfg.standing_fraction)] = 0.0
+        standing = c.get("standing_fraction", self.cfg.standing_fraction)
+        value[draw(self.rng, 0.0, 1.0, n, ref) < standing] = 0.0
         self.value[ids] = value
         self.time_left[ids] = self.cfg.resample_time_s
 
     def update(self) -> None:
         self.time_left -= self.dt
-        self.resample(np.flatnonzero(self.time_left <= 0))
+        self.resample(self.xp.nonzero(self.time_left <= 0)[0])
 
 
-def _at_least(planar: np.ndarray, floor: float) -> np.ndarray:
+def _at_least(planar: Array, floor: float) -> Array:
     """Planar commands slower than `floor` scaled up to it, direction kept (+x if none)."""
-    speed = np.linalg.norm(planar, axis=1, keepdims=True)
-    direction = np.where(speed > 0, planar / np.maximum(speed, 1e-12), [1.0, 0.0])
-    return np.where(speed < floor, direction * floor, planar)
+    xp = namespace(planar)
+    speed = xp.linalg.vector_norm(planar, axis=1, keepdims=True)
+    direction = xp.where(speed > 0, planar / xp.clip(speed, min=1e-12), like([1.0, 0.0], planar))
+    return xp.where(speed < floor, direction * floor, planar)
 
 
 def gait_phase(episode_time: Array, period: float) -> Array:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cached_property
 
 from lca.arrays import Array, as_float, device_of, namespace
 from lca.config.registry import REWARD_TERMS
@@ -39,7 +40,7 @@ class RewardContext:
     # (`sim.data("xpos")[:, sim.body_id("torso_link")]`, `sim.sensor(name)`), no edits elsewhere
     sim: BatchedSim | None = None
 
-    @property
+    @cached_property  # resolved once per step, not once per term
     def xp(self):
         """The array namespace of this step's arrays (NumPy or torch)."""
         return namespace(self.state.base_pos)
