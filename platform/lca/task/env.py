@@ -16,6 +16,7 @@ from omegaconf import DictConfig, OmegaConf
 from rsl_rl.env import VecEnv
 from tensordict import TensorDict
 
+from lca.arrays import Array, as_float, draw, like, namespace
 from lca.config.registry import REWARD_TERMS
 from lca.config.runtime import resolve_device
 from lca.sim.backend import make_sim
@@ -63,20 +64,27 @@ class LocomotionEnv(VecEnv):
         self.num_envs = int(task.num_envs)
         self.scene = scene if scene is not None else build_scene(cfg)
         self.sim = make_sim(self.scene, self.num_envs, cfg.sim, seed=cfg.seed)
-        self.rng = np.random.default_rng(cfg.seed + 1)
+        # the task's arrays live where the physics does: NumPy float64 on the host (mjbatch,
+        # and warp's CPU device), torch tensors on the physics device where the sim hands
+        # them; `ref` gives their type, dtype and device
+        live = self.sim.qpos
+        self._ref = ref = np.zeros(0) if isinstance(live, np.ndarray) else live
+        self.xp = namespace(ref)
+        self.rng = self._generator(cfg.seed + 1)
         self.decimation = int(cfg.sim.decimation)
         self.dt = cfg.sim.timestep * self.decimation
         self.max_episode_length = int(round(task.episode_length_s / self.dt))
         names = self.scene.joint_names
         self.num_actions = len(names)
-        self.default_joint_pos = self.scene.home_joint_pos.copy()
-        self.action_scale = action_scales(self.scene.model, task)
-        self.hip_ids = joint_ids(names, "hip_roll", "hip_yaw")
-        self.arm_ids = joint_ids(names, "shoulder", "elbow", "wrist")
-        self.torso_ids = joint_ids(names, "waist")
+        self.default_joint_pos = like(self.scene.home_joint_pos.copy(), ref)
+        self.action_scale = like(action_scales(self.scene.model, task), ref)
+        self.hip_ids = self._ids(joint_ids(names, "hip_roll", "hip_yaw"))
+        self.arm_ids = self._ids(joint_ids(names, "shoulder", "elbow", "wrist"))
+        self.torso_ids = self._ids(joint_ids(names, "waist"))
         lower, upper = self.scene.model.jnt_range[1 : 1 + self.num_actions].T
         mid, half = (lower + upper) / 2, (upper - lower) / 2 * task.reward_params.soft_limit_factor
-        self.joint_lower, self.joint_upper = mid - half, mid + half
+        self.joint_lower, self.joint_upper = like(mid - half, ref), like(mid + half, ref)
+        self._bad_warning_ids = self._ids(BAD_STATE_WARNINGS)
         self.weights, self.reward_term_params = weights_and_params(task.rewards)
         self.reward_fns = {name: REWARD_TERMS[name] for name in self.weights}
         fns = self.reward_fns.values()
@@ -93,14 +101,14 @@ class LocomotionEnv(VecEnv):
         self.history_terms = observations.history_terms(obs, self.num_actions)
         self.current_terms = observations.current_terms(obs, self.num_actions)
         frame_dim = sum(t.dim for t in self.history_terms)
-        self.history = observations.History(self.num_envs, obs.history, frame_dim)
-        self.critic_history = observations.History(self.num_envs, obs.history, frame_dim)
+        self.history = observations.History(self.num_envs, obs.history, frame_dim, ref)
+        self.critic_history = observations.History(self.num_envs, obs.history, frame_dim, ref)
         self.actor_grid = tuple(obs.actor_grid)
         self.critic_grid = tuple(obs.critic_grid)
         self.actor_offsets = heightmap.grid_offsets(self.actor_grid, obs.actor_spacing)
         self.critic_offsets = heightmap.grid_offsets(self.critic_grid, obs.critic_spacing)
 
-        self.commands = VelocityCommand(task.commands, self.num_envs, self.dt, self.rng)
+        self.commands = VelocityCommand(task.commands, self.num_envs, self.dt, self.rng, ref)
         self.perception_cfg = OmegaConf.to_object(cfg.perception)
         self.cameras = None
         if self.perception_cfg.source == "deployment":
@@ -111,12 +119,10 @@ class LocomotionEnv(VecEnv):
         self.contacts = ContactAccumulator(self.sim)
         self.warnings = self.sim.warnings
         self.episode_length_buf = torch.zeros(self.num_envs, dtype=torch.long, device=self.device)
-        self._episode_steps = np.zeros(self.num_envs, dtype=np.int64)
-        self.action = np.zeros((self.num_envs, self.num_actions))
-        self.last_action = np.zeros_like(self.action)
-        self.episode_sums: dict[str, np.ndarray] = {
-            k: np.zeros(self.num_envs) for k in self.weights
-        }
+        self._episode_steps = self._zeros(self.num_envs, dtype=self.xp.int64)
+        self.action = self._zeros((self.num_envs, self.num_actions))
+        self.last_action = self._zeros((self.num_envs, self.num_actions))
+        self.episode_sums: dict[str, Array] = {k: self._zeros(self.num_envs) for k in self.weights}
         self.nonfinite_resets = 0  # envs reset from a non-finite state (actions included)
         self.nonfinite_actions = 0  # env steps whose action held a NaN or inf
         self._push_steps = (
@@ -125,10 +131,9 @@ class LocomotionEnv(VecEnv):
             else 0
         )
         if task.randomization.enabled:
-            all_ids = np.arange(self.num_envs)
-            mass = self.rng.uniform(*task.randomization.added_base_mass, self.num_envs)
-            self.sim.set_added_base_mass(all_ids, mass)
-        self._reset_envs(np.arange(self.num_envs))
+            mass = draw(self.rng, *task.randomization.added_base_mass, self.num_envs, ref)
+            self.sim.set_added_base_mass(self._all_ids(), mass)
+        self._reset_envs(self._all_ids())
         self._obs = self._observe(read_state(self.sim, self.contacts))
 
     # ---- rsl-rl VecEnv -------------------------------------------------------------------
@@ -136,14 +141,14 @@ class LocomotionEnv(VecEnv):
         return self._obs
 
     def step(self, actions: torch.Tensor) -> tuple[TensorDict, torch.Tensor, torch.Tensor, dict]:
-        clip = self.task_cfg.action_clip
+        xp, clip = self.xp, self.task_cfg.action_clip
         self.last_action = self.action
-        raw = actions.detach().cpu().numpy().astype(np.float64)
-        finite = np.isfinite(raw)
-        bad_action = ~finite.all(axis=1)  # NaN / inf from the policy: counted, zeroed
-        self.action = np.clip(np.where(finite, raw, 0.0), -clip, clip)
+        raw = self._from_policy(actions)
+        finite = xp.isfinite(raw)
+        bad_action = ~xp.all(finite, axis=1)  # NaN / inf from the policy: counted, zeroed
+        self.action = xp.clip(xp.where(finite, raw, like(0.0, raw)), min=-clip, max=clip)
         self.sim.ctrl[:] = self.default_joint_pos + self.action_scale * self.action
-        bad_before = ~np.isfinite(self.sim.qpos).all(1) | ~np.isfinite(self.sim.qvel).all(1)
+        bad_before = ~self._finite_rows(self.sim.qpos) | ~self._finite_rows(self.sim.qvel)
         warnings_before = self._bad_state_warnings()
         self.contacts.clear()
         for _ in range(self.decimation):
@@ -184,8 +189,8 @@ class LocomotionEnv(VecEnv):
             "log": {},
             "metrics": step_metrics(state, self.commands.value, terminated, time_out, strike),
         }
-        done_ids = np.flatnonzero(done)
-        if done_ids.size:
+        done_ids = xp.nonzero(done)[0]
+        if done_ids.shape[0]:
             extras["log"] = self._episode_log(done_ids, fallen, time_out)
         self.nonfinite_resets += int(broken.sum())
         self.nonfinite_actions += int(bad_action.sum())
@@ -201,7 +206,7 @@ class LocomotionEnv(VecEnv):
         for name, factor in self.boosts.items():
             extras["log"][f"Curriculum/boost_{name}"] = factor
         self._reset_envs(done_ids)
-        if done_ids.size:
+        if done_ids.shape[0]:
             state = replace_rows(state, read_state(self.sim, self.contacts, done_ids), done_ids)
         self._obs = self._observe(state, reset_ids=done_ids)
         self.episode_length_buf = torch.as_tensor(self._episode_steps, device=self.device)
@@ -213,16 +218,44 @@ class LocomotionEnv(VecEnv):
         )
 
     # ---- internals -----------------------------------------------------------------------
-    def _bad_state_warnings(self) -> np.ndarray:
-        return self.warnings[:, BAD_STATE_WARNINGS, 1].sum(axis=1)  # [lastinfo, number]
+    def _generator(self, seed: int):
+        """The task's random stream: a NumPy Generator, or a torch.Generator on the device of
+        the physics' tensors."""
+        if isinstance(self._ref, np.ndarray):
+            return np.random.default_rng(seed)
+        return torch.Generator(self._ref.device).manual_seed(seed)
 
-    def _reset_envs(self, ids: np.ndarray) -> None:
-        if ids.size == 0:
+    def _zeros(self, shape, dtype=None) -> Array:
+        ref = self._ref
+        return self.xp.zeros(shape, dtype=dtype or ref.dtype, device=ref.device)
+
+    def _ids(self, ids) -> Array:
+        return self.xp.asarray(np.asarray(ids, dtype=np.int64), device=self._ref.device)
+
+    def _all_ids(self) -> Array:
+        return self.xp.arange(self.num_envs, device=self._ref.device)
+
+    def _from_policy(self, actions: torch.Tensor) -> Array:
+        """The policy's actions in the physics' array type and float dtype."""
+        if isinstance(self._ref, np.ndarray):
+            return actions.detach().cpu().numpy().astype(np.float64)
+        return actions.detach().to(device=self._ref.device, dtype=self._ref.dtype)
+
+    def _finite_rows(self, values: Array) -> Array:
+        return self.xp.all(self.xp.isfinite(values), axis=1)
+
+    def _bad_state_warnings(self) -> Array:
+        # warning[:, w] = [lastinfo, number]
+        return self.xp.sum(self.warnings[:, self._bad_warning_ids, 1], axis=1)
+
+    def _reset_envs(self, ids: Array) -> None:
+        n = int(ids.shape[0])
+        if n == 0:
             return
         self.sim.reset(ids, self.task_cfg.reset)
         rand = self.task_cfg.randomization
         if rand.enabled:
-            self.sim.set_friction_scale(ids, self.rng.uniform(*rand.friction, ids.size))
+            self.sim.set_friction_scale(ids, draw(self.rng, *rand.friction, n, self._ref))
         self.commands.resample(ids)
         self._episode_steps[ids] = 0
         if self.cameras is not None:
@@ -237,18 +270,18 @@ class LocomotionEnv(VecEnv):
     def _maybe_push(self) -> None:
         if self._push_steps <= 0:
             return
-        due = np.flatnonzero((self._episode_steps % self._push_steps) == 0)
-        if due.size:
+        due = self.xp.nonzero((self._episode_steps % self._push_steps) == 0)[0]
+        if due.shape[0]:
             v = self.task_cfg.randomization.push_velocity
             qvel = self.sim.qvel[due]
-            qvel[:, :2] += self.rng.uniform(-v, v, (due.size, 2))
+            qvel[:, :2] += draw(self.rng, -v, v, (int(due.shape[0]), 2), self._ref)
             self.sim.qvel[due] = qvel
 
-    def _phase(self) -> np.ndarray:
+    def _phase(self) -> Array:
         period = self.task_cfg.reward_params.gait_period
-        return gait_phase(self._episode_steps * self.dt, period)
+        return gait_phase(as_float(self._episode_steps, self._ref) * self.dt, period)
 
-    def _reward_context(self, state: RobotState, terminated: np.ndarray) -> RewardContext:
+    def _reward_context(self, state: RobotState, terminated: Array) -> RewardContext:
         return RewardContext(
             state=state,
             command=self.commands.value,
@@ -267,17 +300,18 @@ class LocomotionEnv(VecEnv):
             sim=self.sim,
         )
 
-    def _episode_log(self, ids: np.ndarray, fallen: np.ndarray, time_out: np.ndarray) -> dict:
+    def _episode_log(self, ids: Array, fallen: Array, time_out: Array) -> dict:
+        mean = self.xp.mean
         log = {
-            f"Episode_Reward/{name}": float(sums[ids].mean())
+            f"Episode_Reward/{name}": float(mean(sums[ids]))
             for name, sums in self.episode_sums.items()
         }
-        log["Episode_Termination/fall"] = float(fallen[ids].mean())
-        log["Episode_Termination/time_out"] = float(time_out[ids].mean())
+        log["Episode_Termination/fall"] = float(mean(as_float(fallen[ids], self._ref)))
+        log["Episode_Termination/time_out"] = float(mean(as_float(time_out[ids], self._ref)))
         return log
 
-    def _observe(self, state: RobotState, reset_ids: np.ndarray | None = None) -> TensorDict:
-        n = self.num_envs
+    def _observe(self, state: RobotState, reset_ids: Array | None = None) -> TensorDict:
+        n, xp = self.num_envs, self.xp
         inputs = observations.ObsInputs(
             state,
             self.default_joint_pos,
@@ -291,7 +325,7 @@ class LocomotionEnv(VecEnv):
         frame = observations.build(inputs, self.history_terms, self.rng) if noisy else clean
         self.history.push(frame)
         self.critic_history.push(clean)
-        fresh = np.arange(n) if reset_ids is None else reset_ids
+        fresh = self._all_ids() if reset_ids is None else reset_ids
         self.history.fill(fresh, frame)
         self.critic_history.fill(fresh, clean)
         current = observations.build(inputs, self.current_terms, None)
@@ -307,9 +341,9 @@ class LocomotionEnv(VecEnv):
         )
         critic_map = heightmap.normalise(critic_raw)
         groups = {
-            "policy": np.concatenate([self.history.flat(), actor_current], axis=1),
+            "policy": xp.concat([self.history.flat(), actor_current], axis=1),
             "height": actor_map.reshape(n, 1, *self.actor_grid),
-            "critic": np.concatenate(
+            "critic": xp.concat(
                 [self.critic_history.flat(), current, state.base_lin_vel_world], axis=1
             ),
             "critic_height": critic_map.reshape(n, 1, *self.critic_grid),
@@ -353,7 +387,7 @@ class LocomotionEnv(VecEnv):
 
     def reseed(self, seed: int) -> None:
         """Restart every random stream (resets, noise, commands) from `seed`."""
-        self.rng = np.random.default_rng(seed)
+        self.rng = self._generator(seed)
         self.commands.rng = self.rng
         if self.cameras is not None:
             self.cameras.rng = self.rng
@@ -361,7 +395,7 @@ class LocomotionEnv(VecEnv):
 
     def reset_all(self) -> TensorDict:
         """Reset every environment and return fresh observations."""
-        self._reset_envs(np.arange(self.num_envs))
+        self._reset_envs(self._all_ids())
         self.contacts.clear()
         self.history.buffer[:] = 0.0
         self.critic_history.buffer[:] = 0.0
@@ -390,9 +424,9 @@ class LocomotionEnv(VecEnv):
             device=self.device,
         )
 
-    def _actor_map(self, state: RobotState, yaw: np.ndarray) -> np.ndarray:
+    def _actor_map(self, state: RobotState, yaw: Array) -> Array:
         if not self.perception:
-            return np.zeros((self.num_envs, self.actor_offsets.shape[0]))
+            return self._zeros((self.num_envs, self.actor_offsets.shape[0]))
         if self.cameras is not None:
             return self._camera_map(state, yaw)
         raw = heightmap.sample_heights(

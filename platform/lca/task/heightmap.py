@@ -7,9 +7,11 @@ magnitude and random cell dropout (a dropped cell reads as the mean, i.e. 0).
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
-from lca.arrays import Array, like, namespace
+from lca.arrays import Array, draw, like, namespace
 from lca.sim.terrain import Terrain
 
 
@@ -47,10 +49,10 @@ def normalise(heights: Array, valid: Array | None = None) -> Array:
     return xp.clip(centred, min=-1.0, max=1.0)
 
 
-def actor_map(
-    heights: np.ndarray, noise: float, dropout: float, rng: np.random.Generator
-) -> np.ndarray:
-    """Noisy, sparse map: uniform noise of magnitude `noise`, cells dropped with `dropout`."""
-    noisy = heights + rng.uniform(-noise, noise, heights.shape) if noise > 0 else heights
-    valid = rng.random(heights.shape) >= dropout if dropout > 0 else None
+def actor_map(heights: Array, noise: float, dropout: float, rng: Any) -> Array:
+    """Noisy, sparse map: uniform noise of magnitude `noise`, cells dropped with `dropout`
+    (`rng`: a NumPy Generator, or a torch.Generator on the tensors' device)."""
+    shape = tuple(heights.shape)
+    noisy = heights + draw(rng, -noise, noise, shape, heights) if noise > 0 else heights
+    valid = draw(rng, 0.0, 1.0, shape, heights) >= dropout if dropout > 0 else None
     return normalise(noisy, valid)
