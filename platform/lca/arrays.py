@@ -55,3 +55,39 @@ def uniform(rng: Any, half_width: float, reference: Array) -> Array:
     if isinstance(rng, np.random.Generator):
         return rng.uniform(-half_width, half_width, reference.shape)
     return draw(rng, -1.0, 1.0, tuple(reference.shape), reference) * half_width
+
+
+def generator(seed: int, reference: Array) -> Any:
+    """A random stream for arrays like `reference`: a NumPy Generator, or a torch.Generator on
+    the tensor's device."""
+    if isinstance(reference, np.ndarray):
+        return np.random.default_rng(seed)
+    import torch
+
+    return torch.Generator(reference.device).manual_seed(seed)
+
+
+def rng_state(rng: Any) -> Any:
+    """A generator's state, picklable (see `set_rng_state`)."""
+    return rng.bit_generator.state if isinstance(rng, np.random.Generator) else rng.get_state()
+
+
+def set_rng_state(rng: Any, state: Any) -> None:
+    if isinstance(rng, np.random.Generator):
+        rng.bit_generator.state = state
+    else:
+        rng.set_state(state)
+
+
+def copy_of(value: Array) -> Array:
+    """A copy in the same array type and device."""
+    return namespace(value).asarray(value, copy=True)
+
+
+def to_numpy(value: Any) -> np.ndarray:
+    """A NumPy array of `value` (a tensor is brought to the host; a NumPy array is as is)."""
+    if isinstance(value, np.ndarray):
+        return value
+    if hasattr(value, "detach"):
+        return value.detach().cpu().numpy()
+    return np.asarray(value)

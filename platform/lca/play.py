@@ -22,6 +22,7 @@ from pathlib import Path
 import torch
 from omegaconf import OmegaConf
 
+from lca.arrays import to_numpy
 from lca.cli import split_option
 from lca.config import ConfigError
 from lca.evaluate.clips import Setting, cell_setting, save, shoot
@@ -74,7 +75,7 @@ def view(setting: Setting) -> None:
             start = time.perf_counter()
             obs, _, dones, _ = env.step(policy(obs))
             policy.reset(dones.bool())
-            data.qpos[:] = env.sim.qpos[0]
+            data.qpos[:] = to_numpy(env.sim.qpos[0])
             mujoco.mj_forward(model, data)
             viewer.sync()
             time.sleep(max(0.0, env.dt - (time.perf_counter() - start)))

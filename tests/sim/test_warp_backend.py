@@ -20,15 +20,17 @@ import torch
 from omegaconf import OmegaConf
 
 pytest.importorskip("mujoco_warp", reason="the gpu extra: pip install -e '.[gpu]'")
-
+import warp as wp  # noqa: E402
 from _cli import SMOKE, run_cli  # noqa: E402
 
+from lca.arrays import to_numpy  # noqa: E402
 from lca.config import compose  # noqa: E402
 from lca.config.errors import ConfigValueError  # noqa: E402
 from lca.sim.batch import BatchedSim  # noqa: E402
 from lca.sim.scene import Scene  # noqa: E402
 from lca.sim.warp_batch import WarpSim, buffer_sizes  # noqa: E402
 from lca.task.env import LocomotionEnv  # noqa: E402
+from lca.task.env_state import env_state, restore_env_state  # noqa: E402
 
 # warp's CPU device in CI; .ci/gpu_check runs the same tests with LCA_WARP_DEVICE=cuda
 DEVICE = os.environ.get("LCA_WARP_DEVICE", "cpu")
@@ -59,28 +61,68 @@ def test_warp_steps_the_scene_as_mjbatch_does(mixed_scene: Scene) -> None:
 
 
 def test_task_on_warp_matches_the_task_on_mjbatch(mixed_cfg) -> None:
-    terrain = ["terrain=mixed"]
+    # the same start and commands: the task's random streams differ (NumPy's generator on
+    # mjbatch, torch's on warp's device), so nothing random is drawn here
+    terrain = [
+        "terrain=mixed",
+        *(f"task.reset.{k}=0" for k in ("joint_pos_noise", "base_xy_noise", "yaw_range")),
+        "task.commands.lin_vel_x=[0.4,0.4]",
+        "task.commands.lin_vel_y=[0.1,0.1]",
+        "task.commands.ang_vel_z=[0.2,0.2]",
+        "task.commands.standing_fraction=0",
+    ]
     plain = LocomotionEnv(compose(ENV + terrain))
     warp = LocomotionEnv(compose(ENV + terrain + WARP))
     obs_c, obs_w = plain.reset_all(), warp.reset_all()
+    # the task runs on the physics' tensors, on warp's device: no host copy of the state
+    device = torch.device(warp.sim.device.replace("cuda:0", "cuda"))
+    for value in (warp.sim.qpos, warp.state.base_pos, warp.commands.value, warp.action):
+        assert isinstance(value, torch.Tensor) and value.device == device
+    assert warp.sim.qpos.data_ptr() == wp.to_torch(warp.sim.d.qpos).data_ptr()  # zero copy
     generator = torch.Generator().manual_seed(0)
     for _ in range(20):
         for group in obs_c.keys():  # noqa: SIM118 (a TensorDict)
-            torch.testing.assert_close(obs_w[group], obs_c[group], atol=0.25, rtol=0)
+            torch.testing.assert_close(obs_w[group].cpu(), obs_c[group], atol=0.25, rtol=0)
         before = {k: v.copy() for k, v in plain.episode_sums.items()}
-        before_w = {k: v.copy() for k, v in warp.episode_sums.items()}
+        before_w = {k: to_numpy(v).copy() for k, v in warp.episode_sums.items()}
         action = 0.3 * torch.randn(WORLDS, plain.num_actions, generator=generator)
         obs_c, _, done_c, _ = plain.step(action)
         obs_w, _, done_w, _ = warp.step(action)
         assert not done_c.any() and not done_w.any()
         for name, sums in plain.episode_sums.items():
             np.testing.assert_allclose(
-                warp.episode_sums[name] - before_w[name],
+                to_numpy(warp.episode_sums[name]) - before_w[name],
                 sums - before[name],
                 atol=0.02,
                 err_msg=name,
             )
-    assert warp.sim.overflows.sum() == 0  # the buffers sized from the scene held
+    assert int(warp.sim.overflows.sum()) == 0  # the buffers sized from the scene held
+
+
+def test_task_state_round_trip_on_warp() -> None:
+    """A checkpoint's env state (tensors and a torch generator on warp's device) puts the
+    task back exactly: the same observations and rewards after it, resets included."""
+    env = LocomotionEnv(compose([*ENV, *WARP, "task.observations.noise=true"]))
+    env.reset_all()
+    generator = torch.Generator().manual_seed(1)
+    actions = [torch.randn(WORLDS, env.num_actions, generator=generator) for _ in range(10)]
+    for action in actions[:4]:
+        env.step(action)
+    env.reset_all()  # resets draw from the sim's and the task's generators too
+    saved = env_state(env)
+
+    def run() -> list[torch.Tensor]:
+        out = []
+        for action in actions[4:]:
+            obs, reward, _, _ = env.step(action)
+            out += [obs["policy"].clone(), reward.clone()]
+        return out
+
+    first = run()
+    restore_env_state(env, saved)
+    exact = DEVICE == "cpu"  # a GPU's contact kernels sum in no fixed order
+    for a, b in zip(run(), first, strict=True):
+        torch.testing.assert_close(a, b, rtol=0, atol=0 if exact else 1e-3)
 
 
 def test_state_round_trip_is_exact(flat_scene: Scene) -> None:

@@ -13,6 +13,7 @@ from collections.abc import Callable
 import numpy as np
 import torch
 
+from lca.arrays import like, to_numpy
 from lca.bench.sim import sizes
 from lca.bench.timing import rate
 from lca.config import compose
@@ -41,7 +42,8 @@ def measure(cfg, scene, num_envs: int, threads: int) -> dict:
     env = LocomotionEnv(cfg, scene=scene)
     rss_after = _rss_mb()
     actions = 0.3 * torch.randn(num_envs, env.num_actions)
-    targets = env.default_joint_pos + cfg.task.action_scale * actions.numpy()
+    targets = to_numpy(env.default_joint_pos) + cfg.task.action_scale * actions.numpy()
+    targets = like(targets, env.sim.ctrl)
     calls = [0]
 
     def env_chunk() -> int:

@@ -19,6 +19,7 @@ import numpy as np
 import torch
 from omegaconf import DictConfig
 
+from lca.arrays import to_numpy
 from lca.evaluate.policy import load_policy, sees_map
 from lca.evaluate.protocol import cell_config, cell_name, round_seed
 from lca.evaluate.rollout import rollout, start
@@ -82,11 +83,11 @@ def record(
 
     def capture(text: str) -> None:
         s = env.state
-        velocity = np.array([s.base_lin_vel[0, 0], s.base_lin_vel[0, 1], s.base_ang_vel[0, 2]])
-        rec.qpos.append(env.sim.qpos[0].copy())
-        rec.telemetry.append(
-            Telemetry(steps * env.dt, env.commands.value[0].copy(), velocity, text)
-        )
+        lin, ang = to_numpy(s.base_lin_vel[0]), to_numpy(s.base_ang_vel[0])
+        velocity = np.array([lin[0], lin[1], ang[2]], dtype=np.float64)
+        rec.qpos.append(to_numpy(env.sim.qpos[0]).astype(np.float64))
+        command = to_numpy(env.commands.value[0]).astype(np.float64)
+        rec.telemetry.append(Telemetry(steps * env.dt, command, velocity, text))
 
     capture("")
     last_frame = frames  # a trial past its goal is filmed a little longer, then stops

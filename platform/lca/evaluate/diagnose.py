@@ -15,6 +15,7 @@ Writes `<run>/diagnosis/commands.csv` and `terms.csv` and prints both as tables.
 
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 
@@ -22,6 +23,7 @@ import numpy as np
 import pandas as pd
 import torch
 
+from lca.arrays import like, to_numpy
 from lca.cli import split_option
 from lca.evaluate.config import EvalCell
 from lca.evaluate.policy import final_checkpoint, load_policy, load_run_config
@@ -63,13 +65,15 @@ def hold_command(
     settle = round(SETTLE_S / env.dt)
     velocity, counted = np.zeros(3), 0
     sums = {name: 0.0 for name in env.episode_sums}
-    before = {name: s.copy() for name, s in env.episode_sums.items()}
+    before = {name: to_numpy(s).copy() for name, s in env.episode_sums.items()}
+    command = like(np.asarray(command, dtype=np.float64), env.commands.value)
     env.commands.value[:] = command
-    env.commands.time_left[:] = np.inf
+    env.commands.time_left[:] = math.inf
     alive_steps = 0
     for step, m in rollout(env, policy, obs, steps):
         alive &= ~(m["terminated"] | m["time_out"])
         for name, s in env.episode_sums.items():
+            s = to_numpy(s)
             sums[name] += float(np.sum((s - before[name])[alive]))
             before[name] = s.copy()
         alive_steps += int(alive.sum())

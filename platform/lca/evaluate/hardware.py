@@ -20,6 +20,7 @@ import pandas as pd
 import torch
 from omegaconf import DictConfig
 
+from lca.arrays import to_numpy
 from lca.config import load_option
 from lca.evaluate.clips import Setting, gl_missing, save, shoot
 from lca.evaluate.policy import final_checkpoint, load_policy, sees_map
@@ -44,7 +45,7 @@ def task_config(cfg: DictConfig) -> DictConfig:
 @torch.inference_mode()
 def run_trials(env: LocomotionEnv, policy, task: HardwareTask, steps: int) -> pd.DataFrame:
     obs = start(env, policy)
-    start_y = env.sim.qpos[:, 1].copy()
+    start_y = to_numpy(env.sim.qpos[:, 1]).astype(np.float64)
     return score_trials(rollout(env, policy, obs, steps), start_y, task.goal_x, env.dt)
 
 

@@ -20,6 +20,7 @@ import pandas as pd
 import torch
 from omegaconf import DictConfig, OmegaConf
 
+from lca.arrays import to_numpy
 from lca.config import load_option
 from lca.evaluate.metrics import episode_metrics
 from lca.evaluate.policy import final_checkpoint, load_policy, sees_map
@@ -81,7 +82,7 @@ def run_round(env: LocomotionEnv, policy, steps: int) -> dict[str, np.ndarray]:
     alive_steps = np.zeros(n)
     impacts = np.zeros(n)
     track = np.zeros(n)
-    command_x = env.commands.value[:, 0].copy()
+    command_x = to_numpy(env.commands.value[:, 0]).copy()
     for _, m in rollout(env, policy, obs, steps):
         alive_steps += alive
         impacts += alive & m["lateral_impact"]

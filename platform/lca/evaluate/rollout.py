@@ -9,6 +9,7 @@ from collections.abc import Iterator
 import torch
 from tensordict import TensorDict
 
+from lca.arrays import to_numpy
 from lca.task.env import LocomotionEnv
 
 
@@ -27,5 +28,6 @@ def rollout(
     for step in range(steps) if steps is not None else itertools.count():
         with torch.inference_mode():
             obs, _, dones, extras = env.step(policy(obs))
-        yield step, extras["metrics"]
+        # NumPy for the protocol's bookkeeping, whatever the physics' arrays are
+        yield step, {name: to_numpy(value) for name, value in extras["metrics"].items()}
         policy.reset(dones.bool())

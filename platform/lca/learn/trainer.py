@@ -232,8 +232,8 @@ class Trainer(Checkpoints):
                     )
                     moving = extras["metrics"]["command_speed"] >= MOVING
                     track_sums += (
-                        extras["metrics"]["track_error"][moving].sum(),
-                        extras["metrics"]["command_speed"][moving].sum(),
+                        float(extras["metrics"]["track_error"][moving].sum()),
+                        float(extras["metrics"]["command_speed"][moving].sum()),
                     )
                     self.runner.logger.process_env_step(rewards, dones, extras)
                     stats.add(rewards, dones, extras.get("log", {}))

@@ -10,27 +10,33 @@ import mjbatch
 import mujoco
 import numpy as np
 
+from lca.arrays import Array, copy_of, device_of, draw, like, namespace
 from lca.sim import robot as g1
 from lca.sim.config import ResetConfig
 from lca.sim.scene import Scene
 
 
-def yaw_quat(yaw: np.ndarray) -> np.ndarray:
+def yaw_quat(yaw: Array) -> Array:
     """(N,) heading angles -> (N, 4) wxyz quaternions about +z."""
-    return np.stack([np.cos(yaw / 2), np.zeros_like(yaw), np.zeros_like(yaw), np.sin(yaw / 2)], -1)
+    xp = namespace(yaw)
+    zero = xp.zeros_like(yaw)
+    return xp.stack([xp.cos(yaw / 2), zero, zero, xp.sin(yaw / 2)], axis=-1)
 
 
-def place_home(sim, ids: np.ndarray, noise: ResetConfig | None) -> None:
+def place_home(sim, ids: Array, noise: ResetConfig | None) -> None:
     """Put the just-reset envs `ids` of a batched sim (mjbatch or warp) in the `home` pose on
-    their own tile, with uniform noise on position, heading and joints; ctrl holds home."""
-    n = ids.size
-    xy = sim.env_origin[ids].copy()
-    yaw = np.zeros(n)
-    joints = np.tile(sim.scene.home_joint_pos, (n, 1))
+    their own tile, with uniform noise on position, heading and joints; ctrl holds home.
+    Computed in the sim's array type (on warp's device with `tensors`), from `sim.rng`."""
+    n = int(ids.shape[0])
+    xy = copy_of(sim.env_origin[ids])
+    xp = namespace(xy)
+    yaw = xp.zeros(n, dtype=xy.dtype, device=device_of(xy))
+    home = like(sim.scene.home_joint_pos, xy)
+    joints = xp.tile(home, (n, 1))
     if noise is not None:
-        xy += sim.rng.uniform(-noise.base_xy_noise, noise.base_xy_noise, (n, 2))
-        yaw = sim.rng.uniform(-noise.yaw_range, noise.yaw_range, n)
-        joints += sim.rng.uniform(-noise.joint_pos_noise, noise.joint_pos_noise, joints.shape)
+        xy += draw(sim.rng, -noise.base_xy_noise, noise.base_xy_noise, (n, 2), xy)
+        yaw = draw(sim.rng, -noise.yaw_range, noise.yaw_range, n, xy)
+        joints += draw(sim.rng, -noise.joint_pos_noise, noise.joint_pos_noise, joints.shape, xy)
     ground = sim.scene.terrain.height_at(xy[:, 0], xy[:, 1])
     qpos = sim.qpos[ids]
     qpos[:, :2] = xy
@@ -40,11 +46,10 @@ def place_home(sim, ids: np.ndarray, noise: ResetConfig | None) -> None:
     sim.qpos[ids] = qpos
     if noise is not None and noise.joint_vel_noise > 0:
         qvel = sim.qvel[ids]
-        qvel[:, sim.joint_dof] = sim.rng.uniform(
-            -noise.joint_vel_noise, noise.joint_vel_noise, joints.shape
-        )
+        v = noise.joint_vel_noise
+        qvel[:, sim.joint_dof] = draw(sim.rng, -v, v, tuple(joints.shape), xy)
         sim.qvel[ids] = qvel
-    sim.ctrl[ids] = sim.scene.home_joint_pos
+    sim.ctrl[ids] = home
 
 
 def host_layout(sim, scene: Scene, num_envs: int, seed: int) -> None:

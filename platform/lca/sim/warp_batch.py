@@ -1,11 +1,12 @@
 """N copies of the scene stepping as the worlds of one MuJoCo-Warp model (`sim.backend=warp`).
 
-The interface is `BatchedSim`'s: live (N, ...) numpy arrays `qpos`, `qvel`, `ctrl`, ...,
+The interface is `BatchedSim`'s: live (N, ...) arrays `qpos`, `qvel`, `ctrl`, ...,
 `sensor(name)`, `data(field)`, `step`, `forward`, `reset`, the per-env friction and base mass,
-and the integration state for checkpoints. On warp's CPU device the arrays are the device
-arrays themselves (zero copy). On a GPU they are host mirrors: every step pushes `ctrl` and
-pulls the state back, a round trip that costs the GPU most of its speed until the task runs
-on device tensors (issue 16's remaining part).
+and the integration state for checkpoints. With `tensors=True` (what the task asks for) the
+arrays are torch tensors on warp's device, zero copy through `wp.to_torch`, and resets,
+randomisation and the overflow counts stay on the device too: nothing crosses to the host per
+step. Otherwise they are NumPy: the device arrays themselves on warp's CPU device, host
+mirrors on a GPU (every step pushes `ctrl` and pulls the state back).
 
 Warp computes in float32 (mjbatch: float64); the parity tests state the tolerance. Steps that
 overflow a contact or constraint buffer are counted per world (`overflows`, logged by the env
@@ -22,6 +23,7 @@ import mujoco_warp as mjw
 import numpy as np
 import warp as wp
 
+from lca.arrays import Array, device_of, generator, like, namespace
 from lca.sim.batch import BatchedSim, host_layout, place_home
 from lca.sim.config import ResetConfig
 from lca.sim.scene import Scene
@@ -64,12 +66,15 @@ class WarpSim:
         seed: int = 0,
         nconmax: int = 0,
         njmax: int = 0,
+        tensors: bool = False,
     ):
         self.scene = scene
         self.model = scene.model
         self.num_envs = num_envs
         self.device = warp_device(device)
         self.on_cpu = wp.get_device(self.device).is_cpu
+        self.tensors = tensors
+        self.mirrored = not (tensors or self.on_cpu)  # NumPy host copies of device arrays
         sizes = buffer_sizes(self.model)
         self.nconmax, self.njmax = nconmax or sizes[0], njmax or sizes[1]
         with wp.ScopedDevice(self.device):
@@ -88,41 +93,53 @@ class WarpSim:
         self.ctrl, self.qacc = self._bind("ctrl"), self._bind("qacc")
         self.actuator_force = self._bind("actuator_force")
         self.sensordata, self.time = self._bind("sensordata"), self._bind("time")
-        self.overflows = np.zeros(num_envs, dtype=np.int64)  # steps that overflowed a buffer
-        self.solver_limits = np.zeros(num_envs, dtype=np.int64)  # steps at an iteration limit
+        ref = self.qpos
+        xp = namespace(ref)
+
+        def zeros(shape, dtype) -> np.ndarray:
+            return xp.zeros(shape, dtype=dtype, device=device_of(ref))
+
+        self.overflows = zeros(num_envs, xp.int64)  # steps that overflowed a buffer
+        self.solver_limits = zeros(num_envs, xp.int64)  # steps at an iteration limit
         # mjData.warning's shape (N, mjNWARNING, 2): warp keeps no warnings; NaNs are caught
         # from the state by the task
-        self.warnings = np.zeros((num_envs, N_WARNINGS, 2), np.int32)
+        self.warnings = zeros((num_envs, N_WARNINGS, 2), xp.int32)
         host_layout(self, scene, num_envs, seed)
+        if tensors:  # what resets and randomisation read, on the device
+            self.rng = generator(seed, ref)
+            self.env_origin = like(self.env_origin, ref)
+            self._nominal_friction = like(self._nominal_friction, ref)
+            self._nominal_mass = like(self._nominal_mass, ref)
         self._sensor_adr = {
             self.model.sensor(i).name: (self.model.sensor_adr[i], self.model.sensor_dim[i])
             for i in range(self.model.nsensor)
         }
 
-    def _bind(self, field: str, source=None) -> np.ndarray:
-        """The numpy face of a device array: the array itself on the CPU, else a mirror."""
+    def _bind(self, field: str, source=None) -> Array:
+        """The live face of a device array: a torch view (`tensors`), else NumPy: the array
+        itself on the CPU, a host mirror on a GPU."""
         array = getattr(source if source is not None else self.d, field)
-        view = array.numpy()
+        view = wp.to_torch(array) if self.tensors else array.numpy()
         self._arrays[field] = (array, view)
         return view
 
     def _pull(self) -> None:
-        if not self.on_cpu:
+        if self.mirrored:
             for array, view in self._arrays.values():
                 view[...] = array.numpy()
 
     def _push(self) -> None:
-        if not self.on_cpu:
+        if self.mirrored:
             for array, view in self._arrays.values():
                 array.assign(view)
 
-    def sensor(self, name: str) -> np.ndarray:
+    def sensor(self, name: str) -> Array:
         if name not in self._sensor_adr:
             raise KeyError(f"no sensor '{name}' in the scene")
         adr, dim = self._sensor_adr[name]
         return self.sensordata[:, adr : adr + dim]
 
-    def data(self, field: str) -> np.ndarray:
+    def data(self, field: str) -> Array:
         """A live (N, ...) view of a Data field (`xpos`, `cvel`, `subtree_com`, ...)."""
         if field not in self._arrays:
             self._bind(field)
@@ -136,9 +153,10 @@ class WarpSim:
             raise NotImplementedError("sim.backend=warp steps every world at once")
         self._push()
         with wp.ScopedDevice(self.device):
+            overflow = wp.to_torch(self.d.overflow) if self.tensors else None
             for _ in range(nstep):
                 mjw.step(self.m, self.d)
-                flags = self.d.overflow.numpy()
+                flags = overflow if self.tensors else self.d.overflow.numpy()
                 self.overflows += (flags & ~SOLVER_LIMITS) != 0
                 self.solver_limits += (flags & SOLVER_LIMITS) != 0
                 self.d.overflow.zero_()  # sticky in warp: a count per step instead
@@ -152,34 +170,39 @@ class WarpSim:
             mjw.forward(self.m, self.d)
         self._pull()
 
-    def reset(self, ids: np.ndarray | None = None, noise: ResetConfig | None = None) -> None:
+    def reset(self, ids: Array | None = None, noise: ResetConfig | None = None) -> None:
         """Reset `ids` (all if None) to `home` on their own tile, with uniform noise."""
-        ids = np.arange(self.num_envs) if ids is None else np.asarray(ids, dtype=np.int64)
-        if ids.size == 0:
+        xp = namespace(self.qpos)
+        if ids is None:
+            ids = xp.arange(self.num_envs, device=device_of(self.qpos))
+        if int(ids.shape[0]) == 0:
             return
-        keys = np.full(self.num_envs, -1, dtype=np.int32)
+        keys = xp.full(self.num_envs, -1, dtype=xp.int32, device=device_of(self.qpos))
         keys[ids] = self.scene.home_key
+        keys = wp.from_torch(keys) if self.tensors else wp.array(keys, dtype=int)
         self._push()
         with wp.ScopedDevice(self.device):
-            mjw.reset_data_keyframe(self.m, self.d, wp.array(keys, dtype=int))
+            mjw.reset_data_keyframe(self.m, self.d, keys)
         self._pull()
         place_home(self, ids, noise)
         self.forward(ids)
 
-    def set_friction_scale(self, ids: np.ndarray, scale: np.ndarray) -> None:
+    def set_friction_scale(self, ids: Array, scale: Array) -> None:
         """Sliding friction of every geom of env i = nominal * scale[i]."""
         if self._friction is None:
             self._friction = self._bind("geom_friction", self.m)
-        self._friction[ids, :, 0] = self._nominal_friction[None, :] * np.asarray(scale)[:, None]
+        scale = like(scale, self._nominal_friction)
+        self._friction[ids, :, 0] = self._nominal_friction[None, :] * scale[:, None]
 
-    def set_added_base_mass(self, ids: np.ndarray, added: np.ndarray) -> None:
+    def set_added_base_mass(self, ids: Array, added: Array) -> None:
         """Pelvis mass of env i = nominal + added[i] kg; derived constants are recomputed."""
         if self._body_mass is None:
             self._body_mass = self._bind("body_mass", self.m)
+        added = like(added, self._nominal_mass)
         self._body_mass[ids, self.base_body] = self._nominal_mass[self.base_body] + added
         self.set_const(ids)
 
-    def set_const(self, ids: np.ndarray) -> None:
+    def set_const(self, ids: Array) -> None:
         """Derived model constants recomputed (every world: warp has no per-world form)."""
         self._push()
         with wp.ScopedDevice(self.device):

@@ -16,7 +16,7 @@ from omegaconf import DictConfig, OmegaConf
 from rsl_rl.env import VecEnv
 from tensordict import TensorDict
 
-from lca.arrays import Array, as_float, draw, like, namespace
+from lca.arrays import Array, as_float, draw, generator, like, namespace
 from lca.config.registry import REWARD_TERMS
 from lca.config.runtime import resolve_device
 from lca.sim.backend import make_sim
@@ -63,14 +63,14 @@ class LocomotionEnv(VecEnv):
         self.device = torch.device(resolve_device(cfg.device))
         self.num_envs = int(task.num_envs)
         self.scene = scene if scene is not None else build_scene(cfg)
-        self.sim = make_sim(self.scene, self.num_envs, cfg.sim, seed=cfg.seed)
+        self.sim = make_sim(self.scene, self.num_envs, cfg.sim, seed=cfg.seed, tensors=True)
         # the task's arrays live where the physics does: NumPy float64 on the host (mjbatch,
         # and warp's CPU device), torch tensors on the physics device where the sim hands
         # them; `ref` gives their type, dtype and device
         live = self.sim.qpos
         self._ref = ref = np.zeros(0) if isinstance(live, np.ndarray) else live
         self.xp = namespace(ref)
-        self.rng = self._generator(cfg.seed + 1)
+        self.rng = generator(cfg.seed + 1, ref)
         self.decimation = int(cfg.sim.decimation)
         self.dt = cfg.sim.timestep * self.decimation
         self.max_episode_length = int(round(task.episode_length_s / self.dt))
@@ -218,13 +218,6 @@ class LocomotionEnv(VecEnv):
         )
 
     # ---- internals -----------------------------------------------------------------------
-    def _generator(self, seed: int):
-        """The task's random stream: a NumPy Generator, or a torch.Generator on the device of
-        the physics' tensors."""
-        if isinstance(self._ref, np.ndarray):
-            return np.random.default_rng(seed)
-        return torch.Generator(self._ref.device).manual_seed(seed)
-
     def _zeros(self, shape, dtype=None) -> Array:
         ref = self._ref
         return self.xp.zeros(shape, dtype=dtype or ref.dtype, device=ref.device)
@@ -387,11 +380,11 @@ class LocomotionEnv(VecEnv):
 
     def reseed(self, seed: int) -> None:
         """Restart every random stream (resets, noise, commands) from `seed`."""
-        self.rng = self._generator(seed)
+        self.rng = generator(seed, self._ref)
         self.commands.rng = self.rng
         if self.cameras is not None:
             self.cameras.rng = self.rng
-        self.sim.rng = np.random.default_rng(seed + 1)
+        self.sim.rng = generator(seed + 1, self._ref)
 
     def reset_all(self) -> TensorDict:
         """Reset every environment and return fresh observations."""

@@ -14,6 +14,8 @@ import copy
 import numpy as np
 import torch
 
+from lca.arrays import copy_of, like, rng_state, set_rng_state
+
 ARRAYS = ("_episode_steps", "action", "last_action")
 COUNTERS = ("nonfinite_resets", "nonfinite_actions", "penalty_scale", "only_positive")
 
@@ -22,25 +24,25 @@ def env_state(env) -> dict:
     sim = env.sim
     state = {
         "sim": sim.get_state(),
-        "warning": env.warnings.copy(),
-        "friction": None if sim._friction is None else sim._friction.copy(),
-        "body_mass": None if sim._body_mass is None else sim._body_mass.copy(),
-        "history": env.history.buffer.copy(),
-        "critic_history": env.critic_history.buffer.copy(),
+        "warning": copy_of(env.warnings),
+        "friction": None if sim._friction is None else copy_of(sim._friction),
+        "body_mass": None if sim._body_mass is None else copy_of(sim._body_mass),
+        "history": copy_of(env.history.buffer),
+        "critic_history": copy_of(env.critic_history.buffer),
         "commands": {
-            "value": env.commands.value.copy(),
-            "time_left": env.commands.time_left.copy(),
+            "value": copy_of(env.commands.value),
+            "time_left": copy_of(env.commands.time_left),
             "min_speed": env.commands.min_speed,
         },
-        "episode_sums": {k: v.copy() for k, v in env.episode_sums.items()},
+        "episode_sums": {k: copy_of(v) for k, v in env.episode_sums.items()},
         "perception": env.perception,
         "obs": {k: v.clone() for k, v in env._obs.items()},
         "robot_state": copy.deepcopy(vars(env._state)),
-        "rng": env.rng.bit_generator.state,
-        "sim_rng": sim.rng.bit_generator.state,
+        "rng": rng_state(env.rng),
+        "sim_rng": rng_state(sim.rng),
         "camera": None,
     }
-    state |= {name: getattr(env, name).copy() for name in ARRAYS}
+    state |= {name: copy_of(getattr(env, name)) for name in ARRAYS}
     state |= {name: getattr(env, name) for name in COUNTERS}
     if env.cameras is not None:
         state["camera"] = {"frame": env._camera_frame.copy(), "map": env._deployment_map.copy()}
@@ -59,11 +61,12 @@ def restore_env_state(env, state: dict) -> None:
     sim.set_state(state["sim"])
     env.warnings[:] = state["warning"]
     if state["friction"] is not None:
-        sim.set_friction_scale(np.arange(env.num_envs), np.ones(env.num_envs))  # expand
+        ones = like(np.ones(env.num_envs), env._ref)
+        sim.set_friction_scale(env._all_ids(), ones)  # expand
         sim._friction[:] = state["friction"]
     if state["body_mass"] is not None:
         sim._body_mass[:] = state["body_mass"]
-        sim.set_const(np.arange(env.num_envs))
+        sim.set_const(env._all_ids())
     env.history.buffer[:] = state["history"]
     env.critic_history.buffer[:] = state["critic_history"]
     env.commands.value[:] = state["commands"]["value"]
@@ -80,8 +83,8 @@ def restore_env_state(env, state: dict) -> None:
         env._obs[key] = value.to(env.device)
     for key, value in state["robot_state"].items():
         setattr(env._state, key, value)
-    env.rng.bit_generator.state = state["rng"]
-    sim.rng.bit_generator.state = state["sim_rng"]
+    set_rng_state(env.rng, state["rng"])
+    set_rng_state(sim.rng, state["sim_rng"])
     if state["camera"] is not None:
         env._camera_frame[:] = state["camera"]["frame"]
         env._deployment_map[:] = state["camera"]["map"]
