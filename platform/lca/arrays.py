@@ -52,9 +52,13 @@ def draw(rng: Any, low: float, high: float, shape: tuple, reference: Array) -> A
 
 def uniform(rng: Any, half_width: float, reference: Array) -> Array:
     """Uniform noise in [-half_width, half_width], shaped like `reference` (see `draw`)."""
-    if isinstance(rng, np.random.Generator):
-        return rng.uniform(-half_width, half_width, reference.shape)
-    return draw(rng, -1.0, 1.0, tuple(reference.shape), reference) * half_width
+    return draw(rng, -half_width, half_width, tuple(reference.shape), reference)
+
+
+def zeros(shape: Any, reference: Array, dtype: Any = None) -> Array:
+    """Zeros of `shape` in `reference`'s array type and device (its dtype unless given)."""
+    xp = array_namespace(reference)
+    return xp.zeros(shape, dtype=dtype or reference.dtype, device=device_of(reference))
 
 
 def generator(seed: int, reference: Array) -> Any:

@@ -23,7 +23,7 @@ import mujoco_warp as mjw
 import numpy as np
 import warp as wp
 
-from lca.arrays import Array, device_of, generator, like, namespace
+from lca.arrays import Array, device_of, generator, like, namespace, zeros
 from lca.sim.batch import BatchedSim, host_layout, place_home
 from lca.sim.config import ResetConfig
 from lca.sim.scene import Scene
@@ -95,15 +95,11 @@ class WarpSim:
         self.sensordata, self.time = self._bind("sensordata"), self._bind("time")
         ref = self.qpos
         xp = namespace(ref)
-
-        def zeros(shape, dtype) -> np.ndarray:
-            return xp.zeros(shape, dtype=dtype, device=device_of(ref))
-
-        self.overflows = zeros(num_envs, xp.int64)  # steps that overflowed a buffer
-        self.solver_limits = zeros(num_envs, xp.int64)  # steps at an iteration limit
+        self.overflows = zeros(num_envs, ref, xp.int64)  # steps that overflowed a buffer
+        self.solver_limits = zeros(num_envs, ref, xp.int64)  # steps at an iteration limit
         # mjData.warning's shape (N, mjNWARNING, 2): warp keeps no warnings; NaNs are caught
         # from the state by the task
-        self.warnings = zeros((num_envs, N_WARNINGS, 2), xp.int32)
+        self.warnings = zeros((num_envs, N_WARNINGS, 2), ref, xp.int32)
         host_layout(self, scene, num_envs, seed)
         if tensors:  # what resets and randomisation read, on the device
             self.rng = generator(seed, ref)

@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from lca.arrays import Array, device_of, draw, like, namespace
+from lca.arrays import Array, draw, like, namespace, zeros
 from lca.task.config import CommandConfig
 
 
@@ -28,8 +28,8 @@ class VelocityCommand:
         self.rng = rng
         ref = np.zeros(0) if reference is None else reference
         self.xp = namespace(ref)
-        self.value = self.xp.zeros((num_envs, 3), dtype=ref.dtype, device=device_of(ref))
-        self.time_left = self.xp.zeros(num_envs, dtype=ref.dtype, device=device_of(ref))
+        self.value = zeros((num_envs, 3), ref)
+        self.time_left = zeros(num_envs, ref)
         self.min_speed = 0.0  # the command curriculum's floor on |u_xy| (0: off)
         self.ranges: dict = {}  # the command curriculum's ranges, in place of the config's
 

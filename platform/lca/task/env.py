@@ -16,7 +16,7 @@ from omegaconf import DictConfig, OmegaConf
 from rsl_rl.env import VecEnv
 from tensordict import TensorDict
 
-from lca.arrays import Array, as_float, draw, generator, like, namespace
+from lca.arrays import Array, as_float, draw, generator, like, namespace, zeros
 from lca.config.registry import REWARD_TERMS
 from lca.config.runtime import resolve_device
 from lca.sim.backend import make_sim
@@ -219,8 +219,7 @@ class LocomotionEnv(VecEnv):
 
     # ---- internals -----------------------------------------------------------------------
     def _zeros(self, shape, dtype=None) -> Array:
-        ref = self._ref
-        return self.xp.zeros(shape, dtype=dtype or ref.dtype, device=ref.device)
+        return zeros(shape, self._ref, dtype)
 
     def _ids(self, ids) -> Array:
         return self.xp.asarray(np.asarray(ids, dtype=np.int64), device=self._ref.device)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from lca.arrays import Array, device_of, namespace
+from lca.arrays import Array, namespace, zeros
 from lca.sim import robot as g1
 from lca.sim.batch import BatchedSim
 
@@ -71,15 +71,11 @@ class ContactAccumulator:
             for side in g1.FEET
             for part in g1.UNDESIRED_CONTACT_BODIES
         ]
-        self.xp = xp = namespace(sim.qpos)  # resolved once: update runs every substep
+        self.xp = namespace(sim.qpos)  # resolved once: update runs every substep
 
-        def zeros(width: int) -> Array:
-            shape, like = (sim.num_envs, width), sim.qpos
-            return xp.zeros(shape, dtype=like.dtype, device=device_of(like))
-
-        self.foot_force = zeros(2)
-        self.foot_lateral = zeros(2)
-        self.leg_force = zeros(len(self.legs))
+        self.foot_force = zeros((sim.num_envs, 2), sim.qpos)
+        self.foot_lateral = zeros((sim.num_envs, 2), sim.qpos)
+        self.leg_force = zeros((sim.num_envs, len(self.legs)), sim.qpos)
 
     def clear(self) -> None:
         self.foot_force[:] = 0
