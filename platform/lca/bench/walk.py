@@ -225,6 +225,9 @@ def plot(evals: pd.DataFrame, out: Path) -> None:
                 lambda s, e=evals: _interp(s, e.env_steps / 1e6, e.train_wall_s / 60),
             ),
         )
+        # steps per minute vary along a run: ticks even in minutes, labelled in steps
+        even = np.linspace(0, float(minutes.max()), 6)
+        top.set_xticks(np.round(_interp(even, minutes, evals.env_steps / 1e6), 1))
         top.set_xlabel("environment steps (M)", fontsize=8)
     fig.suptitle(
         "Time to walk: blind MLP, flat ground, scale=cpu (shaded: under the paper's objective)",
