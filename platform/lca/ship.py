@@ -20,13 +20,15 @@ import shutil
 import sys
 from pathlib import Path
 
+import pandas as pd
 import torch
 
+CURVE = "train_curve.csv"
 FILES = (
     "config.yaml",
     "provenance.json",
     "train_cfg.json",
-    "train_curve.csv",
+    CURVE,
     "probe_evals.csv",
     "summary.csv",
     "results.parquet",
@@ -55,7 +57,12 @@ def ship(run_dir: Path, dest: Path, resumable: bool = False, exact: bool = False
     shutil.rmtree(dest, ignore_errors=True)
     dest.mkdir(parents=True)
     for name in FILES:
-        if (run_dir / name).exists():
+        if name == CURVE and (run_dir / name).exists():
+            # a long run logs ~300 bytes an iteration at full float precision; 6 digits halve it
+            pd.read_csv(run_dir / name).to_csv(
+                dest / name, index=False, float_format="%.6g", na_rep="nan"
+            )
+        elif (run_dir / name).exists():
             shutil.copy2(run_dir / name, dest / name)
     if (run_dir / "exported").exists():
         shutil.copytree(run_dir / "exported", dest / "exported")

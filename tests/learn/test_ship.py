@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import pandas as pd
 import pytest
 import torch
 
@@ -56,6 +57,9 @@ def test_exact_ship_keeps_the_whole_checkpoint(unfinished, tmp_path):
     ship.ship(run, tmp_path / "exact", resumable=True, exact=True)
     saved = torch.load(tmp_path / "exact" / "checkpoints" / "latest.pt", weights_only=False)
     assert set(ship.DROPPED_KEYS) <= set(saved)
+    # the curve ships at 6 significant digits, every row and column kept
+    source, shipped = (pd.read_csv(d / ship.CURVE) for d in (run, tmp_path / "exact"))
+    pd.testing.assert_frame_equal(shipped, source, check_dtype=False, rtol=1e-5)
 
 
 def test_exact_needs_resumable(tmp_path):
