@@ -52,6 +52,7 @@ def trial_config(
     c.task.num_envs = num_envs
     c.task.episode_length_s = episode_s
     c.task.randomization.enabled = False
+    c.terrain.levels = False  # a test is its difficulty on every tile, no curriculum
     commands = c.task.commands
     commands.lin_vel_x = list(forward)
     commands.lin_vel_y = [0.0, 0.0]

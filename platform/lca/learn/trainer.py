@@ -58,6 +58,7 @@ CURVE_FIELDS = (
     "falls",
     "nonfinite",
     "nonfinite_actions",
+    "terrain_level",  # mean row of the terrain-level curriculum / top row (terrain.levels)
 )
 BROKEN_STREAK = 3  # iterations whose every episode ends non-finite before a run fails
 MOVING = 0.2  # m/s: commands at least this fast count towards the tracking progress
@@ -279,6 +280,7 @@ class Trainer(Checkpoints):
                 "falls": int(ends[1]),
                 "nonfinite": int(ends[2]),
                 "nonfinite_actions": int(ends[3]),
+                "terrain_level": env.terrain_levels.mean() if env.terrain_levels else math.nan,
                 "tracking_progress": 1.0 - track_sums[0] / track_sums[1]
                 if track_sums[1] > 0
                 else math.nan,

@@ -119,6 +119,12 @@ class TerrainConfig:
     # walking 20 s in any heading never leaves the world
     apron: float = 30.0
     flat_as_plane: bool = True  # an all-flat grid is an infinite plane (cheaper contacts)
+    # IsaacLab's terrain_levels_vel curriculum (not in the paper, which names no terrain
+    # curriculum): rows are difficulty levels, easiest first, one tile type per column;
+    # training envs move up a row after walking half a tile, down after covering less than
+    # half their commanded distance, and past the top row restart on a random one
+    levels: bool = False
+    max_init_level: int = 0  # envs start on rows 0..this (IsaacLab: 5 of 10)
     platform: float = 1.5  # m, flat square at each tile centre where the robot spawns
     num_steps: int = 8  # steps per pyramid side (stairs_up / stairs_down)
     block_size: float = 0.4  # m, side of a block of the uneven field
@@ -147,6 +153,11 @@ class TerrainConfig:
         require(self.platform < self.tile_size, "terrain.platform", "must be < tile_size")
         require(self.apron >= 0, "terrain.apron", f"must be >= 0, got {self.apron}")
         require(self.num_steps >= 1, "terrain.num_steps", f"must be >= 1, got {self.num_steps}")
+        require(
+            0 <= self.max_init_level < self.rows,
+            "terrain.max_init_level",
+            f"must be in [0, rows - 1 = {self.rows - 1}], got {self.max_init_level}",
+        )
 
 
 @group("difficulty")

@@ -11,6 +11,7 @@ range; the tread is the difficulty's depth.
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -90,10 +91,10 @@ class Terrain:
         return self._flat[key]
 
 
-def tile_kinds(cfg: TerrainConfig, rng: np.random.Generator) -> list[str]:
-    """Tile types in proportion to the mixture weights (largest remainder, ties in
-    registration order), shuffled."""
-    n = cfg.rows * cfg.cols
+def tile_kinds(cfg: TerrainConfig, rng: np.random.Generator, n: int | None = None) -> list[str]:
+    """`n` tile types (default: the whole grid) in proportion to the mixture weights (largest
+    remainder, ties in registration order), shuffled."""
+    n = cfg.rows * cfg.cols if n is None else n
     names = TILES.names()
     weights = np.array([float(cfg.mixture.get(t, 0.0)) for t in names], float)
     exact = weights / weights.sum() * n
@@ -160,8 +161,26 @@ def uneven_tile(lx, ly, cfg: TerrainConfig, difficulty: DifficultyConfig, rng) -
     return _blocks(lx, ly, cfg, low, high, rng), {"low": low, "high": high}
 
 
+def level_difficulty(difficulty: DifficultyConfig, level: int, levels: int) -> DifficultyConfig:
+    """Row `level` of a levelled grid: riser and block heights at (level + 1) / levels of
+    the difficulty's, so the last row is the difficulty itself (treads stay)."""
+    scale = (level + 1) / levels
+    out = copy.deepcopy(difficulty)
+    out.stairs_riser = [scale * h for h in difficulty.stairs_riser]
+    out.uneven_height = [scale * h for h in difficulty.uneven_height]
+    return out
+
+
+def grid_kinds(cfg: TerrainConfig, rng: np.random.Generator) -> list[str]:
+    """Row-major tile types; a levelled grid has one type per column, the same on every row."""
+    if not cfg.levels:
+        return tile_kinds(cfg, rng)
+    return tile_kinds(cfg, rng, cfg.cols) * cfg.rows
+
+
 def generate(cfg: TerrainConfig, difficulty: DifficultyConfig, seed: int | None = None) -> Terrain:
-    """Build the whole tile grid. Deterministic in (config, difficulty, seed)."""
+    """Build the whole tile grid. Deterministic in (config, difficulty, seed). With
+    `cfg.levels` the rows are difficulty levels (`level_difficulty`), easiest first."""
     rng = np.random.default_rng(cfg.seed if seed is None else seed)
     res = cfg.resolution
     tile_n = int(round(cfg.tile_size / res))
@@ -173,10 +192,11 @@ def generate(cfg: TerrainConfig, difficulty: DifficultyConfig, seed: int | None 
     local = (np.arange(tile_n) - tile_n / 2) * res  # sample offsets from a tile centre
     ly, lx = np.meshgrid(local, local, indexing="ij")
     tiles = []
-    for index, kind in enumerate(tile_kinds(cfg, rng)):
+    for index, kind in enumerate(grid_kinds(cfg, rng)):
         row, col = divmod(index, cfg.cols)
         centre = ((col + 0.5) * cfg.tile_size, (row + 0.5) * cfg.tile_size)
-        h, params = TILES[kind](lx, ly, cfg, difficulty, rng)
+        level = level_difficulty(difficulty, row, cfg.rows) if cfg.levels else difficulty
+        h, params = TILES[kind](lx, ly, cfg, level, rng)
         r0, c0 = border_n + row * tile_n, border_n + col * tile_n
         heights[r0 : r0 + tile_n, c0 : c0 + tile_n] = h
         tiles.append(Tile(kind, row, col, centre, params))

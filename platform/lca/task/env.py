@@ -36,6 +36,7 @@ from lca.task.state import (
 )
 from lca.task.step_metrics import step_metrics
 from lca.task.terminations import fell, non_finite
+from lca.task.terrain_levels import TerrainLevels
 
 _W = mujoco.mjtWarning
 BAD_STATE_WARNINGS = [int(w) for w in (_W.mjWARN_BADQPOS, _W.mjWARN_BADQVEL, _W.mjWARN_BADQACC)]
@@ -133,6 +134,11 @@ class LocomotionEnv(VecEnv):
         if task.randomization.enabled:
             mass = draw(self.rng, *task.randomization.added_base_mass, self.num_envs, ref)
             self.sim.set_added_base_mass(self._all_ids(), mass)
+        self.terrain_levels = None
+        if cfg.terrain.levels:
+            self.terrain_levels = TerrainLevels(
+                self.sim, cfg.terrain, task.episode_length_s, self.rng
+            )
         self._reset_envs(self._all_ids())
         self._obs = self._observe(read_state(self.sim, self.contacts))
 
@@ -244,6 +250,9 @@ class LocomotionEnv(VecEnv):
         n = int(ids.shape[0])
         if n == 0:
             return
+        if self.terrain_levels is not None:  # episodes that ran: their rows move first
+            ended = ids[self._episode_steps[ids] > 0]
+            self.terrain_levels.update(ended, self.sim.qpos[:, :2], self.commands.value[:, :2])
         self.sim.reset(ids, self.task_cfg.reset)
         rand = self.task_cfg.randomization
         if rand.enabled:

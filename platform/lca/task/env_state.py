@@ -41,9 +41,16 @@ def env_state(env) -> dict:
         "rng": rng_state(env.rng),
         "sim_rng": rng_state(sim.rng),
         "camera": None,
+        "terrain_levels": None,
     }
     state |= {name: copy_of(getattr(env, name)) for name in ARRAYS}
     state |= {name: getattr(env, name) for name in COUNTERS}
+    if env.terrain_levels is not None:
+        levels = env.terrain_levels
+        state["terrain_levels"] = {
+            "level": copy_of(levels.level),
+            "origin": copy_of(sim.env_origin),
+        }
     if env.cameras is not None:
         state["camera"] = {"frame": env._camera_frame.copy(), "map": env._deployment_map.copy()}
     return state
@@ -78,6 +85,9 @@ def restore_env_state(env, state: dict) -> None:
         getattr(env, name)[:] = state[name]
     for name in COUNTERS:
         setattr(env, name, state[name])
+    if state.get("terrain_levels") is not None:
+        env.terrain_levels.level[:] = state["terrain_levels"]["level"]
+        sim.env_origin[:] = state["terrain_levels"]["origin"]
     env.perception = state["perception"]
     for key, value in state["obs"].items():
         env._obs[key] = value.to(env.device)

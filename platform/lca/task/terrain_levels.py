@@ -1,0 +1,58 @@
+"""The terrain-level curriculum (IsaacLab's `terrain_levels_vel`) over a levelled grid.
+
+The grid's rows are difficulty levels, easiest first (`terrain.levels`, `lca.sim.terrain`).
+Each env keeps its column; when its episode ends it moves up a row if it walked more than
+half a tile from its spawn, down a row if it covered less than half the distance its command
+asked for over a whole episode, and an env that walks off the top row restarts on a random
+one, so the hardest rows never empty.
+"""
+
+from __future__ import annotations
+
+from lca.arrays import Array, device_of, draw, like, namespace
+
+
+class TerrainLevels:
+    """Per-env rows of a levelled grid, moved at each reset; sets the sim's spawn origins."""
+
+    def __init__(self, sim, terrain_cfg, episode_s: float, rng) -> None:
+        self.sim = sim
+        self.rows, self.cols = int(terrain_cfg.rows), int(terrain_cfg.cols)
+        self.tile_size = float(terrain_cfg.tile_size)
+        self.episode_s = float(episode_s)
+        self.rng = rng
+        origin = sim.env_origin
+        self.xp = xp = namespace(origin)
+        self.centres = like(sim.scene.terrain.tile_centres(), origin)
+        n, device = int(origin.shape[0]), device_of(origin)
+        self.column = xp.arange(n, device=device) % self.cols
+        self.level = self._uniform_rows(terrain_cfg.max_init_level + 1, n)
+        self._place(xp.arange(n, device=device))
+
+    def update(self, ids: Array, base_xy: Array, command_xy: Array) -> None:
+        """Move the envs `ids`, whose episodes just ended at `base_xy` under `command_xy`
+        (both (N, 2), every env), and put their next spawns on their new rows."""
+        xp = self.xp
+        walked = xp.linalg.vector_norm(base_xy[ids] - self.sim.env_origin[ids], axis=1)
+        asked = xp.linalg.vector_norm(command_xy[ids], axis=1) * self.episode_s
+        up = walked > self.tile_size / 2
+        down = (walked < asked / 2) & ~up
+        level = self.level[ids] + xp.astype(up, xp.int64) - xp.astype(down, xp.int64)
+        restart = self._uniform_rows(self.rows, int(ids.shape[0]))
+        self.level[ids] = xp.where(level >= self.rows, restart, xp.clip(level, min=0))
+        self._place(ids)
+
+    def mean(self) -> float:
+        """The mean level as a fraction of the top row (0: all on row 0, 1: all on the top)."""
+        return float(self.xp.mean(self.xp.astype(self.level, self.centres.dtype))) / max(
+            self.rows - 1, 1
+        )
+
+    def _uniform_rows(self, rows: int, n: int) -> Array:
+        """`n` row indices uniform in 0..rows - 1."""
+        u = draw(self.rng, 0.0, float(rows), n, self.centres)
+        return self.xp.clip(self.xp.astype(self.xp.floor(u), self.xp.int64), max=rows - 1)
+
+    def _place(self, ids: Array) -> None:
+        tile = self.level[ids] * self.cols + self.column[ids]
+        self.sim.env_origin[ids] = self.centres[tile]
