@@ -62,6 +62,7 @@ CURVE_FIELDS = (
 )
 BROKEN_STREAK = 3  # iterations whose every episode ends non-finite before a run fails
 MOVING = 0.2  # m/s: commands at least this fast count towards the tracking progress
+TRACKED = ("track_error", "command_speed")  # the step metrics the tracking progress sums
 
 
 def _number(text: str):
@@ -69,6 +70,14 @@ def _number(text: str):
         return float(text)
     except ValueError:
         return text
+
+
+def _masked_sum(values, mask):
+    """Sum of `values` where `mask`: NumPy sums the selection; torch sums a `where`, which
+    needs no host sync to size a selection."""
+    if isinstance(values, np.ndarray):
+        return values[mask].sum()
+    return torch.where(mask, values, 0.0).sum()
 
 
 def _fmt_eta(seconds: float) -> str:
@@ -208,8 +217,10 @@ class Trainer(Checkpoints):
             ceiling = noise_ceiling(cfg.actor, it, self.total, self.rewards.progress)
             apply_ceiling(actor, ceiling)
             actor.kl_values = []
-            track_sums = np.zeros(2)  # |u - v| and |u| over moving commands
-            ends = np.zeros(4, dtype=np.int64)  # episodes ended, falls, non-finite, bad actions
+            # tallies stay in the env's array type until the iteration ends: no host sync per
+            # step on a GPU. |u - v| and |u| over moving commands; episodes ended, falls,
+            # non-finite, bad actions
+            track_sums, ends = [0.0, 0.0], [0, 0, 0, 0]
             t0 = time.perf_counter()
             update_threads = torch.get_num_threads()
             if cfg.collect_threads > 0:
@@ -225,20 +236,18 @@ class Trainer(Checkpoints):
                     )
                     alg.process_env_step(obs, rewards, dones, extras)
                     m = extras["metrics"]
-                    ends += (
-                        int(dones.sum()),
-                        int(m["fell"].sum()),
-                        int(m["nonfinite"].sum()),
-                        int(m["nonfinite_action"].sum()),
-                    )
-                    moving = extras["metrics"]["command_speed"] >= MOVING
-                    track_sums += (
-                        float(extras["metrics"]["track_error"][moving].sum()),
-                        float(extras["metrics"]["command_speed"][moving].sum()),
-                    )
+                    counts = (dones, m["fell"], m["nonfinite"], m["nonfinite_action"])
+                    ends = [total + count.sum() for total, count in zip(ends, counts, strict=True)]
+                    moving = m["command_speed"] >= MOVING
+                    track_sums = [
+                        total + _masked_sum(m[key], moving)
+                        for total, key in zip(track_sums, TRACKED, strict=True)
+                    ]
                     self.runner.logger.process_env_step(rewards, dones, extras)
                     stats.add(rewards, dones, extras.get("log", {}))
                 alg.compute_returns(obs)
+            ends = np.array([int(v) for v in ends], dtype=np.int64)
+            track_sums = np.array([float(v) for v in track_sums])
             torch.set_num_threads(update_threads)
             t1 = time.perf_counter()
             self._freeze_actor(it < cfg.algo.critic_warmup)

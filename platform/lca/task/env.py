@@ -198,11 +198,15 @@ class LocomotionEnv(VecEnv):
         done_ids = xp.nonzero(done)[0]
         if done_ids.shape[0]:
             extras["log"] = self._episode_log(done_ids, fallen, time_out)
-        self.nonfinite_resets += int(broken.sum())
-        self.nonfinite_actions += int(bad_action.sum())
-        extras["log"]["Episode_Termination/nonfinite_total"] = float(self.nonfinite_resets)
-        extras["log"]["Episode_Termination/nonfinite_actions_total"] = float(self.nonfinite_actions)
-        extras["log"]["Sim/buffer_overflows_total"] = float(self.sim.overflows.sum())
+        # counts and logged means stay in the sim's array type: no host sync per step on a GPU
+        self.nonfinite_resets = self.nonfinite_resets + xp.sum(xp.astype(broken, xp.int64))
+        self.nonfinite_actions = self.nonfinite_actions + xp.sum(xp.astype(bad_action, xp.int64))
+        log = extras["log"]
+        log["Episode_Termination/nonfinite_total"] = as_float(self.nonfinite_resets, self._ref)
+        log["Episode_Termination/nonfinite_actions_total"] = as_float(
+            self.nonfinite_actions, self._ref
+        )
+        log["Sim/buffer_overflows_total"] = as_float(xp.sum(self.sim.overflows), self._ref)
         extras["metrics"]["fell"] = fallen
         extras["metrics"]["nonfinite"] = broken
         extras["metrics"]["nonfinite_action"] = bad_action
@@ -303,12 +307,9 @@ class LocomotionEnv(VecEnv):
 
     def _episode_log(self, ids: Array, fallen: Array, time_out: Array) -> dict:
         mean = self.xp.mean
-        log = {
-            f"Episode_Reward/{name}": float(mean(sums[ids]))
-            for name, sums in self.episode_sums.items()
-        }
-        log["Episode_Termination/fall"] = float(mean(as_float(fallen[ids], self._ref)))
-        log["Episode_Termination/time_out"] = float(mean(as_float(time_out[ids], self._ref)))
+        log = {f"Episode_Reward/{k}": mean(sums[ids]) for k, sums in self.episode_sums.items()}
+        log["Episode_Termination/fall"] = mean(as_float(fallen[ids], self._ref))
+        log["Episode_Termination/time_out"] = mean(as_float(time_out[ids], self._ref))
         return log
 
     def _observe(self, state: RobotState, reset_ids: Array | None = None) -> TensorDict:
