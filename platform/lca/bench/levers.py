@@ -1,11 +1,14 @@
-"""The learning levers, each measured against the same wall-clock budget.
+"""The learning levers, each measured against the same budget.
 
-    python -m lca.bench levers [budget_s=1200] [only=a,b] [runs=runs/levers]
+    python -m lca.bench levers [budget_s=1200 | budget_its=326] [only=a,b] [runs=runs/levers]
 
 Every lever is one run of the time-to-walk benchmark (blind MLP, flat ground, `scale=cpu`)
 with the recipe's defaults changed by the lever's overrides, trained for `budget_s` seconds
-of wall-clock and evaluated in-process with the paper's protocol on a flat cell. A finished
-lever is reused (its run directory holds its result); writes reports/learning_levers.md.
+of wall-clock (probed every quarter of it) or for `budget_its` iterations (the same env
+steps for every lever: each collects 6144 a iteration; probed at the end only, and fair
+whatever else the machine runs), and evaluated in-process with the paper's protocol on a
+flat cell. A finished lever is reused (its run directory holds its result); writes
+reports/learning_levers.md.
 """
 
 from __future__ import annotations
@@ -76,7 +79,11 @@ def run(args: list[str], log: Callable[[str], None] | None = print) -> dict:
     budgets, args = split_option(args, "budget_s")
     onlys, args = split_option(args, "only")
     roots, args = split_option(args, "runs")
+    its, args = split_option(args, "budget_its")
     budget = float(budgets[-1]) if budgets else 1200.0
+    iterations = int(its[-1]) if its else 0
+    if iterations:  # the schedule stays the recipe's; the run stops after `iterations`
+        budget, args = 1e9, [*args, f"until={iterations}"]
     root = Path(roots[-1] if roots else "runs/levers")
     names = onlys[-1].split(",") if onlys else list(LEVERS)
     unknown = [n for n in names if n not in LEVERS]
@@ -107,13 +114,15 @@ def run(args: list[str], log: Callable[[str], None] | None = print) -> dict:
             "success": final["success"],
             "track_cm_s": final["track_cm_s"],
             "mean_steps": final["mean_steps"],
+            "still_cm_s": final.get("still_cm_s", float("nan")),
             "env_steps": r["env_steps"],
             "steps_per_s": r["steps_per_s"],
             "time_to_walk_s": r["time_to_walk_s"],
         }
     physics = physics_cost(log)
-    write_markdown(results, physics, budget, walk.REPORTS / "learning_levers.md")
-    return {"budget_s": budget, "levers": results, "physics": physics}
+    label = f"{iterations}-iteration" if iterations else f"{budget / 60:.0f}-minute"
+    write_markdown(results, physics, label, walk.REPORTS / "learning_levers.md")
+    return {"budget": label, "levers": results, "physics": physics}
 
 
 # physics-cost levers: env steps/s (N=256, 2 threads, random actions) on flat ground
@@ -138,7 +147,7 @@ def _walked_at(seconds: float | None) -> str:
     return "-" if seconds is None else f"{seconds / 60:.0f} min"
 
 
-def write_markdown(results: dict, physics: dict, budget: float, path: Path) -> None:
+def write_markdown(results: dict, physics: dict, budget: str, path: Path) -> None:
     base = next(iter(physics.values()))["steps_per_s"]
     physics_rows = "\n".join(
         f"| {name} | `{' '.join(r['overrides']) or '-'}` | {r['steps_per_s']:,.0f} | "
@@ -147,17 +156,19 @@ def write_markdown(results: dict, physics: dict, budget: float, path: Path) -> N
     )
     rows = "\n".join(
         f"| {name} | {r['what']} | {r['success']:.1f} | {r['track_cm_s']:.1f} | "
-        f"{r['env_steps'] / 1e6:.2f} | {r['steps_per_s']:,.0f} | "
+        f"{r.get('still_cm_s', float('nan')):.1f} | {r['env_steps'] / 1e6:.2f} | "
+        f"{r['steps_per_s']:,.0f} | "
         f"{_walked_at(r['time_to_walk_s'])} |"
         for name, r in results.items()
     )
     path.write_text(
-        f"# Learning levers at a {budget / 60:.0f}-minute budget\n\n"
+        f"# Learning levers at a {budget} budget\n\n"
         "`python -m lca.bench levers`: blind MLP, flat ground, `scale=cpu`, 2 CPU cores. "
         "Success and tracking: the paper's protocol on a flat cell (64 units x 1000 steps, "
         "forward 0.3-0.6 m/s) at the end of the budget.\n\n"
-        "| lever | change | success (%) | track (cm/s) | env steps (M) | steps/s | walked at |\n"
-        "|---|---|---:|---:|---:|---:|---:|\n"
+        "| lever | change | success (%) | track (cm/s) | still (cm/s) | env steps (M) | "
+        "steps/s | walked at |\n"
+        "|---|---|---:|---:|---:|---:|---:|---:|\n"
         f"{rows}\n\n"
         "Physics cost on flat ground (`LocomotionEnv.step`, 256 envs, 2 threads, random "
         "actions, median of 3):\n\n"
@@ -167,7 +178,7 @@ def write_markdown(results: dict, physics: dict, budget: float, path: Path) -> N
 
 
 def table(r: dict) -> str:
-    lines = [f"budget {r['budget_s'] / 60:.0f} min"]
+    lines = [f"budget: {r['budget']}"]
     for name, x in r["levers"].items():
         lines.append(
             f"{name:>20}: success {x['success']:5.1f} %  track {x['track_cm_s']:5.1f} cm/s  "
