@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+import copy
 import math
 import re
 
 import mujoco
 import numpy as np
+import pytest
 
 from lca.sim.batch import BatchedSim
-from lca.sim.scene import Scene
+from lca.sim.scene import Scene, build_scene
 
 
 def _group_of(cfg, joint: str) -> str:
@@ -30,7 +32,16 @@ def _reflected_inertia(group) -> float:
     )
 
 
-def test_scene_structure(mixed_scene: Scene) -> None:
+@pytest.fixture(scope="module")
+def field_scene(mixed_cfg) -> Scene:
+    """The mixed smoke terrain as one heightfield (terrain.representation=heightfield)."""
+    cfg = copy.deepcopy(mixed_cfg)
+    cfg.terrain.representation = "heightfield"
+    return build_scene(cfg)
+
+
+def test_scene_structure(field_scene: Scene) -> None:
+    mixed_scene = field_scene
     model = mixed_scene.model
     assert model.nu == 29 and len(mixed_scene.joint_names) == 29
     terrain_geom = model.geom("terrain")
@@ -71,7 +82,8 @@ def test_actuators_pd_gains_and_limits(flat_cfg, flat_scene: Scene) -> None:
     assert actuated == set(flat_scene.joint_names)
 
 
-def test_heightfield_matches_height_at_by_raycast(mixed_scene: Scene) -> None:
+def test_heightfield_matches_height_at_by_raycast(field_scene: Scene) -> None:
+    mixed_scene = field_scene
     model, terrain = mixed_scene.model, mixed_scene.terrain
     data = mujoco.MjData(model)
     data.qpos[:] = mixed_scene.home_qpos

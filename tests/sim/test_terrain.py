@@ -118,7 +118,8 @@ def test_uneven_block_edges_on_block_grid() -> None:
             assert np.all(edges % block_n == 0), f"block edges at samples {edges}"
 
 
-def test_height_at_exact_on_samples_and_triangles(mixed_cfg) -> None:
+def test_field_height_at_exact_on_samples_and_triangles(mixed_cfg) -> None:
+    """The heightfield representation's query (test_relief.py checks the boxes')."""
     terrain = generate(mixed_cfg.terrain, mixed_cfg.difficulty)
     h, res = terrain.heights, terrain.resolution
     (ox, oy), (nrow, ncol) = terrain.origin, h.shape
@@ -128,7 +129,9 @@ def test_height_at_exact_on_samples_and_triangles(mixed_cfg) -> None:
     # Include the last row/column and the corners.
     r = np.r_[r, 0, nrow - 1, 0, nrow - 1]
     c = np.r_[c, 0, 0, ncol - 1, ncol - 1]
-    np.testing.assert_allclose(terrain.height_at(ox + c * res, oy + r * res), h[r, c], atol=1e-12)
+    np.testing.assert_allclose(
+        terrain.field_height_at(ox + c * res, oy + r * res), h[r, c], atol=1e-12
+    )
     # Inside a cell: the diagonal runs from (r, c) to (r+1, c+1), so the cell centre is the
     # mean of those two samples, and a point on a row edge interpolates that edge. Random
     # cells, plus every cell whose corners are not coplanar (where the diagonal matters).
@@ -137,10 +140,12 @@ def test_height_at_exact_on_samples_and_triangles(mixed_cfg) -> None:
     r = np.r_[rng.integers(0, nrow - 1, 500), bent[:, 0]]
     c = np.r_[rng.integers(0, ncol - 1, 500), bent[:, 1]]
     x, y = ox + (c + 0.5) * res, oy + (r + 0.5) * res
-    np.testing.assert_allclose(terrain.height_at(x, y), (h[r, c] + h[r + 1, c + 1]) / 2, atol=1e-12)
+    np.testing.assert_allclose(
+        terrain.field_height_at(x, y), (h[r, c] + h[r + 1, c + 1]) / 2, atol=1e-12
+    )
     f = rng.uniform(0, 1, len(r))
     np.testing.assert_allclose(
-        terrain.height_at(ox + (c + f) * res, oy + r * res),
+        terrain.field_height_at(ox + (c + f) * res, oy + r * res),
         (1 - f) * h[r, c] + f * h[r, c + 1],
         atol=1e-12,
     )
@@ -159,8 +164,7 @@ def test_same_seed_same_terrain(mixed_cfg) -> None:
 
 
 def test_mixture_gives_each_kind_equally() -> None:
-    cfg = compose(["terrain=mixed"])
-    assert (cfg.terrain.rows, cfg.terrain.cols) == (4, 4)
+    cfg = compose(["terrain=mixed", "terrain.rows=4", "terrain.cols=4"])
     for seed in range(5):
         counts = Counter(tile_kinds(cfg.terrain, np.random.default_rng(seed)))
         assert counts == dict.fromkeys(TILES.names(), 4), counts

@@ -33,6 +33,9 @@ class EvalConfig:
     units: int = 32  # simulated robots per cell (paper: 500)
     episodes: int = 2  # episodes per unit (paper: 3)
     steps: int = 500  # policy steps per episode (paper: 1000)
+    # rows x cols tiles of each cell's terrain: 16 draws of riser or block field per cell,
+    # whatever grid the policy trained on
+    grid: list[int] = field(default_factory=lambda: [4, 4])
     cells: list[EvalCell] = field(  # stairs = half the tiles up, half down
         default_factory=lambda: [
             EvalCell(t, d) for t in ("stairs", "uneven") for d in ("medium", "hard")
@@ -49,6 +52,11 @@ class EvalConfig:
     def check(self) -> None:
         for key in ("units", "episodes", "steps"):
             require(getattr(self, key) >= 1, f"eval.{key}", "must be >= 1")
+        require(
+            len(self.grid) == 2 and min(self.grid) >= 1,
+            "eval.grid",
+            f"must be [rows, cols] >= 1, got {list(self.grid)}",
+        )
         require(
             self.video_seconds > 0, "eval.video_seconds", f"must be > 0, got {self.video_seconds}"
         )

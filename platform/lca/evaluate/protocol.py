@@ -68,6 +68,7 @@ def cell_config(cfg: DictConfig, cell) -> DictConfig:
     episode_s = ev.steps * cfg.sim.timestep * cfg.sim.decimation
     c = trial_config(cfg, ev.units, episode_s, ev.command_x)
     c.terrain.mixture = eval_mixture(cell.terrain)
+    c.terrain.rows, c.terrain.cols = ev.grid
     c.terrain.name = cell.terrain
     c.difficulty = difficulty_config(cell.difficulty)
     return c

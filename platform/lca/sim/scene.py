@@ -1,4 +1,5 @@
-"""Compose the G1 and the terrain heightfield into one compiled MuJoCo model."""
+"""Compose the G1 and the terrain (boxes, a heightfield or a plane) into one compiled MuJoCo
+model."""
 
 from __future__ import annotations
 
@@ -11,9 +12,8 @@ from omegaconf import DictConfig
 
 from lca.sim import robot as g1
 from lca.sim.config import RobotConfig, SimConfig
+from lca.sim.relief import BASE_DEPTH, add_boxes
 from lca.sim.terrain import Terrain, generate
-
-HFIELD_BASE_DEPTH = 0.5  # m of solid below the lowest terrain point
 
 INTEGRATORS = {
     "euler": mujoco.mjtIntegrator.mjINT_EULER,
@@ -50,10 +50,10 @@ def apply_sim_options(spec: mujoco.MjSpec, cfg: SimConfig) -> None:
 def add_terrain(
     spec: mujoco.MjSpec, terrain: Terrain, apron: float = 0.0, plane: bool = False
 ) -> None:
-    """Add `terrain` as an hfield geom (MuJoCo stores heights normalised to [0, 1]), or, with
-    `plane` (for an all-flat terrain), as an infinite plane at height 0. `apron` > 0 surrounds
-    the hfield with flat ground at height 0 (its border's height) that far on every side."""
-    h = terrain.heights
+    """Add `terrain` as its representation says: box geoms (with the flat border as four
+    boxes around the tiles) or one hfield geom (MuJoCo stores heights normalised to [0, 1]);
+    with `plane` (an all-flat terrain), an infinite plane at height 0. `apron` > 0 surrounds
+    it with flat ground at height 0 (its border's height) that far on every side."""
     rgba = [0.45, 0.5, 0.55, 1.0]
     collide = {"contype": g1.TERRAIN_CONTYPE, "conaffinity": g1.TERRAIN_CONAFFINITY, "condim": 3}
     if plane:
@@ -61,13 +61,23 @@ def add_terrain(
             name="terrain", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 1], rgba=rgba, **collide
         )
         return
+    (x0, y0), (sx, sy) = terrain.origin, terrain.size
+    if terrain.representation == "boxes":
+        add_boxes(spec, terrain, rgba, collide)
+        # the border (inside the sample grid) joins the apron: flat ground around the tiles
+        border = -x0
+        if border + apron > 0:
+            tiles = (sx - 2 * border, sy - 2 * border)
+            _add_apron(spec, (0.0, 0.0), tiles, border + apron, rgba, collide)
+        return
+    h = terrain.heights
     low, span = float(h.min()), float(np.ptp(h))
     span = max(span, 1e-3)  # MuJoCo needs a positive elevation range even for flat ground
     nrow, ncol = h.shape
     sx, sy = terrain.size
     spec.add_hfield(
         name="terrain",
-        size=[sx / 2, sy / 2, span, HFIELD_BASE_DEPTH],
+        size=[sx / 2, sy / 2, span, BASE_DEPTH],
         nrow=nrow,
         ncol=ncol,
         userdata=((h - low) / span).astype(np.float32).ravel(),
@@ -82,13 +92,14 @@ def add_terrain(
         **collide,
     )
     if apron > 0:
-        _add_apron(spec, terrain, apron, rgba, collide)
+        _add_apron(spec, (x0, y0), (sx, sy), apron, rgba, collide)
 
 
-def _add_apron(spec, terrain: Terrain, apron: float, rgba, collide) -> None:
-    """Four boxes, top face at z = 0, framing the heightfield (x strips span the corners)."""
-    (x0, y0), (sx, sy) = terrain.origin, terrain.size
-    depth = HFIELD_BASE_DEPTH
+def _add_apron(spec, origin, size, apron: float, rgba, collide) -> None:
+    """Four boxes, top face at z = 0, framing the rectangle at `origin` of `size` (x strips
+    span the corners)."""
+    (x0, y0), (sx, sy) = origin, size
+    depth = BASE_DEPTH
     for i, (cx, cy, hx, hy) in enumerate(
         [
             (x0 - apron / 2, y0 + sy / 2, apron / 2, sy / 2 + apron),

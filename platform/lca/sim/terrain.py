@@ -1,5 +1,10 @@
-"""Procedural terrain: a grid of square tiles (flat, stairs up/down, uneven blocks) as one
-heightfield array, with an exact vectorised height query.
+"""Procedural terrain: a grid of square tiles (flat, stairs up/down, uneven blocks), with an
+exact vectorised height query for each of its two representations in the physics.
+
+Every built-in tile is piecewise constant on a rectilinear grid of its own (its `edges`: riser,
+block and platform lines), so it is also stored as cells (`Tile.cells`) that the scene turns
+into box geoms (`terrain.representation=boxes`); the 1 cm sample array `heights` is what the
+heightfield representation compiles, and what previews draw.
 
 Stairs are square pyramids around the tile centre. `stairs_up` is a pit: the robot spawns on
 the bottom platform and climbs outwards in any direction; `stairs_down` is a hill it descends.
@@ -28,6 +33,10 @@ class Tile:
     col: int
     centre: tuple[float, float]  # world x, y
     params: dict[str, float] = field(default_factory=dict)
+    # (edges, heights): local breakpoints from -tile_size/2 to +tile_size/2 (the same on x
+    # and y) and the height of each cell between them, [y cell, x cell]; None for a tile
+    # that is not piecewise constant (a plugin's slopes): it stays a heightfield
+    cells: tuple[np.ndarray, np.ndarray] | None = field(default=None, compare=False)
 
 
 @dataclass
@@ -38,6 +47,10 @@ class Terrain:
     resolution: float
     origin: tuple[float, float]
     tiles: list[Tile]
+    # what the physics collides with: "heightfield" (the samples, triangulated) or "boxes"
+    # (each tile's cells as boxes; tiles without cells stay a heightfield of their own)
+    representation: str = "heightfield"
+    tile_size: float = 0.0
     _flat: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     @property
@@ -55,6 +68,15 @@ class Terrain:
         return np.array([t.centre for t in self.tiles])
 
     def height_at(self, x: Array, y: Array) -> Array:
+        """Surface height at world points, exactly as the physics sees it: the boxes' tops
+        (a point on a vertical edge takes the cell on its +x / +y side), or the heightfield."""
+        if self.representation != "boxes":
+            return self.field_height_at(x, y)
+        from lca.sim.relief import cell_height_at
+
+        return cell_height_at(self, x, y)
+
+    def field_height_at(self, x: Array, y: Array) -> Array:
         """Surface height at world points, exactly as MuJoCo's heightfield triangulates it.
 
         Each grid cell is split along the diagonal from sample (r, c) to (r+1, c+1); points
@@ -116,6 +138,23 @@ def _stairs(lx, ly, cfg, riser, tread, up: bool) -> np.ndarray:
     return -riser * levels_below_top if up else riser * levels_below_top
 
 
+def stairs_edges(cfg: TerrainConfig, difficulty: DifficultyConfig) -> np.ndarray:
+    """Local lines where a pyramid's height changes: the platform's and each riser's."""
+    half = cfg.tile_size / 2
+    rings = cfg.platform / 2 + difficulty.stairs_tread * np.arange(cfg.num_steps)
+    rings = rings[rings < half - 1e-9]
+    return np.unique(np.round(np.concatenate([[-half, half], rings, -rings]), 9))
+
+
+def blocks_edges(cfg: TerrainConfig, difficulty: DifficultyConfig) -> np.ndarray:
+    """Local lines where a block field's height changes: block sides and the platform's."""
+    half = cfg.tile_size / 2
+    nb = int(round(cfg.tile_size / cfg.block_size))
+    sides = -half + cfg.block_size * np.arange(nb)
+    platform = np.array([-cfg.platform / 2, cfg.platform / 2])
+    return np.unique(np.round(np.concatenate([[half], sides, platform]), 9))
+
+
 def _blocks(lx, ly, cfg, low, high, rng) -> np.ndarray:
     """Random block field; the spawn platform is one flat block."""
     half = cfg.tile_size / 2
@@ -134,7 +173,13 @@ def _blocks(lx, ly, cfg, low, high, rng) -> np.ndarray:
 TileOut = tuple[np.ndarray, dict[str, float]]
 
 
-@TILES.register("flat", label="Flat")
+def flat_edges(cfg: TerrainConfig, difficulty: DifficultyConfig) -> np.ndarray:
+    return np.array([-cfg.tile_size / 2, cfg.tile_size / 2])
+
+
+# A tile registers `edges=f(cfg, difficulty)` when its height is constant between those
+# local lines (on x and on y): it can then be built from boxes.
+@TILES.register("flat", label="Flat", edges=flat_edges)
 def flat_tile(lx, ly, cfg: TerrainConfig, difficulty: DifficultyConfig, rng) -> TileOut:
     return np.zeros_like(lx), {}
 
@@ -145,17 +190,17 @@ def _stairs_tile(lx, ly, cfg, difficulty, rng, up: bool) -> TileOut:
     return _stairs(lx, ly, cfg, riser, difficulty.stairs_tread, up=up), params
 
 
-@TILES.register("stairs_up", label="Stairs up")
+@TILES.register("stairs_up", label="Stairs up", edges=stairs_edges)
 def stairs_up_tile(lx, ly, cfg: TerrainConfig, difficulty: DifficultyConfig, rng) -> TileOut:
     return _stairs_tile(lx, ly, cfg, difficulty, rng, up=True)
 
 
-@TILES.register("stairs_down", label="Stairs down")
+@TILES.register("stairs_down", label="Stairs down", edges=stairs_edges)
 def stairs_down_tile(lx, ly, cfg: TerrainConfig, difficulty: DifficultyConfig, rng) -> TileOut:
     return _stairs_tile(lx, ly, cfg, difficulty, rng, up=False)
 
 
-@TILES.register("uneven", label="Uneven Terrain")
+@TILES.register("uneven", label="Uneven Terrain", edges=blocks_edges)
 def uneven_tile(lx, ly, cfg: TerrainConfig, difficulty: DifficultyConfig, rng) -> TileOut:
     low, high = difficulty.uneven_height
     return _blocks(lx, ly, cfg, low, high, rng), {"low": low, "high": high}
@@ -196,8 +241,24 @@ def generate(cfg: TerrainConfig, difficulty: DifficultyConfig, seed: int | None 
         row, col = divmod(index, cfg.cols)
         centre = ((col + 0.5) * cfg.tile_size, (row + 0.5) * cfg.tile_size)
         level = level_difficulty(difficulty, row, cfg.rows) if cfg.levels else difficulty
-        h, params = TILES[kind](lx, ly, cfg, level, rng)
+        h, params, cells = _tile(kind, lx, ly, cfg, level, rng)
         r0, c0 = border_n + row * tile_n, border_n + col * tile_n
         heights[r0 : r0 + tile_n, c0 : c0 + tile_n] = h
-        tiles.append(Tile(kind, row, col, centre, params))
-    return Terrain(heights=heights, resolution=res, origin=origin, tiles=tiles)
+        tiles.append(Tile(kind, row, col, centre, params, cells))
+    return Terrain(heights, res, origin, tiles, cfg.representation, cfg.tile_size)
+
+
+def _tile(kind, lx, ly, cfg, difficulty, rng) -> tuple[np.ndarray, dict, tuple | None]:
+    """A tile's samples, drawn parameters and cells. The cell heights come from the same call
+    (its cell centres appended to the sample points), so they share its random draws."""
+    edges_of = TILES.entry(kind).meta.get("edges")
+    if edges_of is None:
+        h, params = TILES[kind](lx, ly, cfg, difficulty, rng)
+        return h, params, None
+    edges = edges_of(cfg, difficulty)
+    mid = (edges[:-1] + edges[1:]) / 2
+    cy, cx = np.meshgrid(mid, mid, indexing="ij")
+    points_x = np.concatenate([lx.ravel(), cx.ravel()])
+    points_y = np.concatenate([ly.ravel(), cy.ravel()])
+    h, params = TILES[kind](points_x, points_y, cfg, difficulty, rng)
+    return h[: lx.size].reshape(lx.shape), params, (edges, h[lx.size :].reshape(cx.shape))
