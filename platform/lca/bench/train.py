@@ -88,7 +88,7 @@ def measure(overrides: list[str], log: Callable[[str], None] | None = print) -> 
     result = {
         "backend": cfg.sim.backend,
         "terrain": cfg.terrain.name,
-        "representation": cfg.terrain.representation,
+        "representation": _representation(cfg),
         "num_envs": int(cfg.task.num_envs),
         "steps_per_env": int(cfg.algo.num_steps_per_env),
         "learning_epochs": int(cfg.algo.num_learning_epochs),
@@ -109,6 +109,14 @@ def measure(overrides: list[str], log: Callable[[str], None] | None = print) -> 
     if log:
         log(f"{cfg.terrain.name}: median of {len(rows)} iterations after {WARMUP} warm-up")
     return result
+
+
+def _representation(cfg) -> str:
+    """What the physics collides with: an all-flat grid is the plane (terrain.flat_as_plane)."""
+    kinds = {kind for kind, weight in cfg.terrain.mixture.items() if weight > 0}
+    return (
+        "plane" if kinds == {"flat"} and cfg.terrain.flat_as_plane else cfg.terrain.representation
+    )
 
 
 def table(r: dict) -> str:
