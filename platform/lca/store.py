@@ -22,6 +22,7 @@ from pathlib import Path
 
 from omegaconf import DictConfig, OmegaConf
 
+from lca.departures import departures
 from lca.paths import root
 
 LOCK = ".lock"
@@ -74,16 +75,6 @@ def versions() -> dict:
         except metadata.PackageNotFoundError:
             found[name] = None
     return found
-
-
-def departures(cfg: DictConfig) -> list[str]:
-    """Settings of this run that are not the paper's, for anyone reading its numbers."""
-    out = []
-    if cfg.encoder.kind == "cnn" and int(cfg.encoder.pool) > 1:
-        out.append(f"encoder.pool={cfg.encoder.pool}: CNN with max-pooling (rows: CNN (pooled))")
-    if cfg.scale.name != "paper":
-        out.append(f"scale={cfg.scale.name}: fewer environments and iterations than the paper")
-    return out
 
 
 class RunLockedError(RuntimeError):

@@ -116,12 +116,23 @@ def _add_tile_field(spec, terrain: Terrain, tile: Tile, base: float, rgba, colli
 class CellGrid:
     """Every tile's cells on one world grid: `heights[j, i]` holds between xs[i-1] and xs[i]
     and ys[j-1] and ys[j] (index 0 and the last: outside the tiles, flat ground at 0); NaN
-    on a tile without cells."""
+    on a tile without cells. `x_bucket[k]` is the cell index at the start of the k-th
+    `resolution`-wide bucket from xs[0] (every line lies on a bucket boundary), so a lookup is
+    two gathers and a comparison instead of a binary search."""
 
     xs: np.ndarray
     ys: np.ndarray
     heights: np.ndarray
     any_field: bool
+    resolution: float
+    x_bucket: np.ndarray
+    y_bucket: np.ndarray
+
+
+def _buckets(lines: np.ndarray, resolution: float) -> np.ndarray:
+    n = int(round((lines[-1] - lines[0]) / resolution)) + 1
+    starts = lines[0] + resolution * np.arange(n)
+    return np.searchsorted(lines, starts + resolution / 2, side="right")
 
 
 def cell_grid(terrain: Terrain) -> CellGrid:
@@ -146,7 +157,21 @@ def cell_grid(terrain: Terrain) -> CellGrid:
         i = np.searchsorted(edges, mx[cols] - tile.centre[0]) - 1
         j = np.searchsorted(edges, my[rows] - tile.centre[1]) - 1
         heights[block] = cell_heights[np.ix_(j, i)]
-    return CellGrid(xs, ys, heights, bool(np.isnan(heights).any()))
+    res = terrain.resolution
+    any_field = bool(np.isnan(heights).any())
+    return CellGrid(xs, ys, heights, any_field, res, _buckets(xs, res), _buckets(ys, res))
+
+
+def _cell_index(x: Array, lines: Array, bucket: Array, resolution: float, xp) -> Array:
+    """Index of the cell holding x (0: before lines[0]; len(lines): past the last): the
+    bucket's first cell, moved on by one where x has reached the next line (a bucket holds
+    at most one line, at its start; the comparison also settles rounding at a line)."""
+    n = bucket.shape[0]
+    k = xp.astype(xp.clip(xp.floor((x - lines[0]) / resolution), min=0, max=n - 1), xp.int64)
+    i = xp.take(bucket, k)
+    nxt = xp.take(lines, xp.clip(i, max=lines.shape[0] - 1))
+    i = i + xp.astype((x >= nxt) & (i < lines.shape[0]), xp.int64)
+    return xp.where(x < lines[0], xp.zeros_like(i), i)
 
 
 def cell_height_at(terrain: Terrain, x: Array, y: Array) -> Array:
@@ -160,17 +185,20 @@ def cell_height_at(terrain: Terrain, x: Array, y: Array) -> Array:
         grid = terrain._flat.get("cells") or cell_grid(terrain)
         terrain._flat["cells"] = grid
 
-        def on(a: np.ndarray) -> Array:
-            return xp.asarray(a, dtype=x.dtype, device=device_of(x))
+        def on(a: np.ndarray, dtype=x.dtype) -> Array:
+            return xp.asarray(a, dtype=dtype, device=device_of(x))
 
-        terrain._flat[key] = (on(grid.xs), on(grid.ys), on(grid.heights.ravel()), grid)
-    xs, ys, flat, grid = terrain._flat[key]
+        terrain._flat[key] = (
+            [on(grid.xs), on(grid.x_bucket, xp.int64)],
+            [on(grid.ys), on(grid.y_bucket, xp.int64)],
+            on(grid.heights.ravel()),
+            grid,
+        )
+    x_lookup, y_lookup, flat, grid = terrain._flat[key]
     shape = x.shape
     x, y = xp.reshape(x, (-1,)), xp.reshape(y, (-1,))
-    if hasattr(x, "contiguous"):  # torch searches contiguous values without a copy
-        x, y = x.contiguous(), y.contiguous()
-    i = xp.searchsorted(xs, x, side="right")
-    j = xp.searchsorted(ys, y, side="right")
+    i = _cell_index(x, *x_lookup, grid.resolution, xp)
+    j = _cell_index(y, *y_lookup, grid.resolution, xp)
     h = xp.take(flat, j * (grid.xs.shape[0] + 1) + i)
     if grid.any_field:
         h = xp.where(xp.isnan(h), terrain.field_height_at(x, y), h)

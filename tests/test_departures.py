@@ -1,0 +1,35 @@
+"""Departures from the paper are derived from the config against the paper profile."""
+
+from __future__ import annotations
+
+from lca.config import compose
+from lca.departures import departures
+
+
+def test_paper_profile_departs_nowhere() -> None:
+    assert departures(compose(["scale=paper", "encoder.pool=0"])) == []
+
+
+def test_every_changed_training_setting_is_listed_with_both_values() -> None:
+    cfg = compose(
+        [
+            "policy=blind",
+            "terrain=flat",
+            "algo.symmetry=true",
+            "robot.collision_parts=[feet,legs]",
+            "seed=3",
+            "eval.units=7",
+        ]
+    )
+    found = departures(cfg)
+    text = "\n".join(found)
+    assert "algo.symmetry=True (paper: False)" in found
+    assert (
+        "robot.collision_parts=['feet', 'legs'] (paper: ['feet', 'legs', 'torso', 'arms'])" in found
+    )
+    assert "algo.num_learning_epochs=2 (paper: 5)" in found  # scale=cpu's
+    assert "task.num_envs=256 (paper: 4096)" in found
+    assert any(line.startswith("terrain.mixture={flat: 1} (paper: {flat: 0.25") for line in found), text
+    assert "task.reward_curriculum.enabled=True (paper: False)" in found
+    # the study's axes and bookkeeping are not departures
+    assert not any(line.startswith(("seed", "eval.", "actor.name", "scale.name")) for line in found)
