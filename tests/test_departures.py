@@ -29,7 +29,8 @@ def test_every_changed_training_setting_is_listed_with_both_values() -> None:
     )
     assert "algo.num_learning_epochs=2 (paper: 5)" in found  # scale=cpu's
     assert "task.num_envs=256 (paper: 4096)" in found
-    assert any(line.startswith("terrain.mixture={flat: 1} (paper: {flat: 0.25") for line in found), text
+    mixture = "terrain.mixture={flat: 1} (paper: {flat: 0.25"
+    assert any(line.startswith(mixture) for line in found), text
     assert "task.reward_curriculum.enabled=True (paper: False)" in found
     # the study's axes and bookkeeping are not departures
     assert not any(line.startswith(("seed", "eval.", "actor.name", "scale.name")) for line in found)
