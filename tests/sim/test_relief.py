@@ -74,10 +74,10 @@ def edge_points(scene, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray
         for e in edges:
             for side in (-1e-3, 1e-3):
                 along = rng.uniform(-terrain.tile_size / 2, terrain.tile_size / 2, 20)
-                x += list(tile.centre[0] + e + side + 0 * along)
+                x += [tile.centre[0] + e + side] * len(along)
                 y += list(tile.centre[1] + along)
                 x += list(tile.centre[0] + along)
-                y += list(tile.centre[1] + e + side + 0 * along)
+                y += [tile.centre[1] + e + side] * len(along)
     return np.array(x), np.array(y)
 
 
