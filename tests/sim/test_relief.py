@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from lca.config import compose
-from lca.sim.relief import rectangles
+from lca.sim.relief import cell_grid, rectangles
 from lca.sim.scene import build_scene
 from lca.sim.terrain import generate
 from lca.task.heightmap import grid_offsets, sample_heights
@@ -187,3 +187,20 @@ def test_height_at_on_torch_matches_numpy() -> None:
     x, y = rng.uniform(-2, 18, 1000), rng.uniform(-2, 18, 1000)
     on_torch = terrain.height_at(torch.as_tensor(x), torch.as_tensor(y))
     np.testing.assert_array_equal(on_torch.numpy(), terrain.height_at(x, y))
+
+
+def test_cell_lookup_is_exact_at_every_line() -> None:
+    """The bucket lookup finds the cell a binary search finds, on every line and on the
+    floats either side of it (where rounding decides), and far outside the grid."""
+    cfg = compose([*FULL, "difficulty=hard"])
+    terrain = generate(cfg.terrain, cfg.difficulty)
+    grid = cell_grid(terrain)
+    rng = np.random.default_rng(3)
+    lines = np.concatenate([grid.xs, grid.ys])
+    near = np.concatenate([lines, np.nextafter(lines, -np.inf), np.nextafter(lines, np.inf)])
+    across = rng.uniform(-50, 50, len(near))
+    x = np.concatenate([near, across, rng.uniform(-50, 50, 5000)])
+    y = np.concatenate([across, near, rng.uniform(-50, 50, 5000)])
+    i = np.searchsorted(grid.xs, x, side="right")
+    j = np.searchsorted(grid.ys, y, side="right")
+    np.testing.assert_array_equal(terrain.height_at(x, y), grid.heights[j, i])

@@ -116,9 +116,9 @@ def _add_tile_field(spec, terrain: Terrain, tile: Tile, base: float, rgba, colli
 class CellGrid:
     """Every tile's cells on one world grid: `heights[j, i]` holds between xs[i-1] and xs[i]
     and ys[j-1] and ys[j] (index 0 and the last: outside the tiles, flat ground at 0); NaN
-    on a tile without cells. `x_bucket[k]` is the cell index at the start of the k-th
-    `resolution`-wide bucket from xs[0] (every line lies on a bucket boundary), so a lookup is
-    two gathers and a comparison instead of a binary search."""
+    on a tile without cells. A lookup needs no binary search: `x_bucket[k]` is the cell at
+    the start of the k-th `resolution`-wide bucket from `xs[0] - resolution` (every line lies
+    on a bucket boundary), and a comparison with the cell's lines settles rounding there."""
 
     xs: np.ndarray
     ys: np.ndarray
@@ -130,9 +130,11 @@ class CellGrid:
 
 
 def _buckets(lines: np.ndarray, resolution: float) -> np.ndarray:
-    n = int(round((lines[-1] - lines[0]) / resolution)) + 1
-    starts = lines[0] + resolution * np.arange(n)
-    return np.searchsorted(lines, starts + resolution / 2, side="right")
+    """Cell index of each bucket, from one bucket before the first line (cell 0) to one
+    starting at the last line (past every line)."""
+    n = int(round((lines[-1] - lines[0]) / resolution)) + 2
+    centres = lines[0] + resolution * (np.arange(n) - 0.5)
+    return np.searchsorted(lines, centres, side="right")
 
 
 def cell_grid(terrain: Terrain) -> CellGrid:
@@ -162,16 +164,23 @@ def cell_grid(terrain: Terrain) -> CellGrid:
     return CellGrid(xs, ys, heights, any_field, res, _buckets(xs, res), _buckets(ys, res))
 
 
-def _cell_index(x: Array, lines: Array, bucket: Array, resolution: float, xp) -> Array:
-    """Index of the cell holding x (0: before lines[0]; len(lines): past the last): the
-    bucket's first cell, moved on by one where x has reached the next line (a bucket holds
-    at most one line, at its start; the comparison also settles rounding at a line)."""
-    n = bucket.shape[0]
-    k = xp.astype(xp.clip(xp.floor((x - lines[0]) / resolution), min=0, max=n - 1), xp.int64)
+def _cell_index(x: Array, lookup: tuple, xp) -> Array:
+    """Index of the cell holding x: 0 before the first line, len(lines) past the last."""
+    start, inverse, bucket, lower, upper = lookup
+    k = xp.clip(
+        xp.astype(xp.floor((x - start) * inverse), xp.int64), min=0, max=bucket.shape[0] - 1
+    )
     i = xp.take(bucket, k)
-    nxt = xp.take(lines, xp.clip(i, max=lines.shape[0] - 1))
-    i = i + xp.astype((x >= nxt) & (i < lines.shape[0]), xp.int64)
-    return xp.where(x < lines[0], xp.zeros_like(i), i)
+    i = i + xp.astype(x >= xp.take(upper, i), xp.int64)
+    return i - xp.astype(x < xp.take(lower, i), xp.int64)
+
+
+def _lookup(lines: np.ndarray, bucket: np.ndarray, resolution: float, on, xp) -> tuple:
+    """(first bucket's start, 1 / resolution, bucket cells, each cell's lower and upper
+    line): the outer cells' outer lines are infinite, so a point past every line stays."""
+    lower, upper = np.insert(lines, 0, -np.inf), np.append(lines, np.inf)
+    start = float(lines[0] - resolution)
+    return (start, 1.0 / resolution, on(bucket, xp.int64), on(lower), on(upper))
 
 
 def cell_height_at(terrain: Terrain, x: Array, y: Array) -> Array:
@@ -189,16 +198,15 @@ def cell_height_at(terrain: Terrain, x: Array, y: Array) -> Array:
             return xp.asarray(a, dtype=dtype, device=device_of(x))
 
         terrain._flat[key] = (
-            [on(grid.xs), on(grid.x_bucket, xp.int64)],
-            [on(grid.ys), on(grid.y_bucket, xp.int64)],
+            _lookup(grid.xs, grid.x_bucket, grid.resolution, on, xp),
+            _lookup(grid.ys, grid.y_bucket, grid.resolution, on, xp),
             on(grid.heights.ravel()),
             grid,
         )
     x_lookup, y_lookup, flat, grid = terrain._flat[key]
     shape = x.shape
     x, y = xp.reshape(x, (-1,)), xp.reshape(y, (-1,))
-    i = _cell_index(x, *x_lookup, grid.resolution, xp)
-    j = _cell_index(y, *y_lookup, grid.resolution, xp)
+    i, j = _cell_index(x, x_lookup, xp), _cell_index(y, y_lookup, xp)
     h = xp.take(flat, j * (grid.xs.shape[0] + 1) + i)
     if grid.any_field:
         h = xp.where(xp.isnan(h), terrain.field_height_at(x, y), h)
