@@ -51,3 +51,33 @@ def test_walking_needs_the_paper_objective():
     assert not walk.walks(
         {k: v for k, v in row.items() if k != "still_cm_s"} | {"paper_objective": 1}
     )
+
+
+def test_walking_on_terrain_needs_stairs_and_uneven():
+    row = {"success": 100.0, "track_cm_s": 10.0, "still_cm_s": 3.0, "paper_objective": 1}
+    row |= {"penalty_scale": 1.0, "stairs_success": 85.0, "uneven_success": 81.0}
+    assert walk.walks(row)
+    assert not walk.walks({**row, "stairs_success": 79.0})
+    assert not walk.walks({**row, "uneven_success": 50.0})
+    assert walk.walks({**row, "stairs_success": float("nan"), "uneven_success": float("nan")})
+
+
+def test_a_run_on_terrain_is_probed_on_stairs_and_uneven(tmp_path):
+    walk.run(
+        [
+            *SMOKE,
+            "terrain=mixed",
+            f"run={tmp_path / 'run'}",
+            f"figure={tmp_path / 'walk.png'}",
+            "iterations=2",
+            "eval_every_s=0",
+            "eval_from=2",
+            "eval.units=2",
+            "eval.steps=20",
+        ],
+        log=None,
+    )
+    probes = pd.read_csv(tmp_path / "run" / "probe_evals.csv")
+    assert list(probes["iteration"]) == [1]
+    for key in ("stairs_success", "uneven_success"):
+        assert 0.0 <= probes[key].iloc[0] <= 100.0, probes.to_dict()

@@ -1,4 +1,5 @@
-"""Time-to-walk: train a blind MLP on flat ground from scratch at `scale=cpu` until it walks.
+"""Time-to-walk: train a blind MLP from scratch at `scale=cpu` until it walks, on flat ground
+or (`terrain=mixed`) on the paper's terrain.
 
     python -m lca.bench walk [--json] [overrides] [cap_s=10800] [eval_every_s=240]
         [iterations=2450] [until=0] [eval_from=0] [run=runs/bench_walk] [resume=false]
@@ -9,7 +10,9 @@ the paper's protocol on a flat cell (forward commands 0.3-0.6 m/s, 1000-step epi
 observation noise, no randomisation), and on a zero command (16 units, 5 s); that time is not
 counted. The policy *walks* at the first evaluation with success >= 90 %, tracking error
 <= 20 cm/s and a base speed <= 20 cm/s when told to stand, while the objective is the paper's
-(the reward curriculum, if any, has finished). Reports time_to_walk_s,
+(the reward curriculum, if any, has finished). Trained on terrain, it is also probed on
+stairs and uneven terrain at medium difficulty and walks only with >= 80 % success on each.
+Reports time_to_walk_s,
 steps_to_walk, steps/s, writes the curve figure reports/bench/walk.png and the run directory
 (a complete run: config, provenance, curve, checkpoints, exported policy).
 """
@@ -61,6 +64,8 @@ TRACK_MAX = 20.0  # cm/s
 # of reports/learning.md did): it must also stand still when the command is zero
 STILL_MAX = 20.0  # cm/s of base speed under a zero command
 STILL_UNITS, STILL_STEPS = 16, 250
+TERRAIN_CELLS = (EvalCell("stairs", "medium"), EvalCell("uneven", "medium"))
+TERRAIN_SUCCESS_MIN = 80.0  # % on each terrain cell, for a run trained on terrain
 OPTIONS = {
     "cap_s": 3 * 3600.0,
     "eval_every_s": 240.0,
@@ -86,12 +91,19 @@ def parse(args: list[str]) -> tuple[dict, list[str]]:
 
 
 def walks(row: dict) -> bool:
+    on_terrain = [row[k] for k in terrain_keys() if k in row and not math.isnan(row[k])]
     return (
         row["success"] >= SUCCESS_MIN
         and row["track_cm_s"] <= TRACK_MAX
         and row.get("still_cm_s", math.nan) <= STILL_MAX
         and bool(row.get("paper_objective", row["penalty_scale"] >= 1.0))
+        and all(success >= TERRAIN_SUCCESS_MIN for success in on_terrain)
     )
+
+
+def terrain_keys() -> list[str]:
+    """The probe columns of the terrain cells: `<terrain>_success`."""
+    return [f"{cell.terrain}_success" for cell in TERRAIN_CELLS]
 
 
 def run(args: list[str], log: Callable[[str], None] | None = print) -> dict:
@@ -122,6 +134,13 @@ def run(args: list[str], log: Callable[[str], None] | None = print) -> dict:
         train_cfg,
         command_x=[0.0, 0.0],
     )
+    # on terrain: the same protocol on stairs and uneven ground, success only
+    terrain_probes = {
+        f"{cell.terrain}_success": TrainingProbe(
+            cfg, None, cell, cfg.eval.units, cfg.eval.steps, train_cfg
+        )
+        for cell in (TERRAIN_CELLS if cfg.terrain.name != "flat" else ())
+    }
     trainer = Trainer(cfg, run)
     state = {"next": 0.0, "walked": None}
     for row in TrainingProbe.read(probe.out):  # a resumed benchmark keeps its earlier evaluations
@@ -139,6 +158,10 @@ def run(args: list[str], log: Callable[[str], None] | None = print) -> dict:
         standing = still.evaluate(trainer.alg.get_policy())
         result["still_cm_s"] = standing["track_cm_s"]
         result["eval_s"] += standing["eval_s"]
+        for key, terrain_probe in terrain_probes.items():
+            on_terrain = terrain_probe.evaluate(trainer.alg.get_policy())
+            result[key] = on_terrain["success"]
+            result["eval_s"] += on_terrain["eval_s"]
         entry = {
             "iteration": it,
             "env_steps": row["env_steps"],
@@ -155,7 +178,8 @@ def run(args: list[str], log: Callable[[str], None] | None = print) -> dict:
                 f"[walk] {wall / 60:6.1f} min {row['env_steps'] / 1e6:6.2f} M steps | success "
                 f"{result['success']:5.1f} % | track {result['track_cm_s']:5.1f} cm/s | "
                 f"still {result['still_cm_s']:5.1f} cm/s | "
-                f"penalties x{row['penalty_scale']:.2f} | eval {result['eval_s']:.0f} s"
+                + "".join(f"{k.split('_')[0]} {result[k]:5.1f} % | " for k in terrain_probes)
+                + f"penalties x{row['penalty_scale']:.2f} | eval {result['eval_s']:.0f} s"
             )
         if walks(entry) and state["walked"] is None:
             state["walked"] = entry
@@ -190,11 +214,15 @@ def summarise(run: RunDir, overrides: list[str], opts: dict, walked: dict | None
             "success_min": SUCCESS_MIN,
             "track_max_cm_s": TRACK_MAX,
             "still_max_cm_s": STILL_MAX,
+            "terrain_success_min": TERRAIN_SUCCESS_MIN,
         },
         "probe": {
             "units": int(cfg.eval.units),
             "steps": int(cfg.eval.steps),
             "cell": "flat-medium",
+            "terrain_cells": [f"{c.terrain}-{c.difficulty}" for c in TERRAIN_CELLS]
+            if cfg.terrain.name != "flat"
+            else [],
         },
         "evals": evals.to_dict(orient="records"),
         "run_dir": str(run.path),
@@ -230,7 +258,7 @@ def plot(evals: pd.DataFrame, out: Path) -> None:
         top.set_xticks(np.round(_interp(even, minutes, evals.env_steps / 1e6), 1))
         top.set_xlabel("environment steps (M)", fontsize=8)
     fig.suptitle(
-        "Time to walk: blind MLP, flat ground, scale=cpu (shaded: under the paper's objective)",
+        "Time to walk: blind MLP, scale=cpu (shaded: under the paper's objective)",
         fontsize=11,
     )
     fig.tight_layout()

@@ -32,6 +32,8 @@ PROBE_FIELDS = (
     "success",
     "track_cm_s",
     "still_cm_s",
+    "stairs_success",
+    "uneven_success",
     "contacts_per_step",
     "mean_steps",
     "eval_s",
