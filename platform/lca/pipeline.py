@@ -15,6 +15,7 @@ from omegaconf import DictConfig
 from lca.evaluate.run import evaluate_and_write
 from lca.learn.run import train_run
 from lca.report.build import build_report
+from lca.report.reference import reference_runs
 from lca.store import FAILED, RunDir
 
 
@@ -40,7 +41,8 @@ def run_pipeline(
         summary["results"] = {"episodes": "results.parquet", "summary": "summary.csv"}
         run.mark_complete(json.loads(json.dumps(summary, default=str)))  # results are final
         if report:  # a view of the complete run; rebuilt any time with `python -m lca.report`
-            index = build_report([run.path], run.path / "report")
+            # shipped policies evaluated on the same cells, so a first table has signal
+            index = build_report([run.path, *reference_runs(cfg)], run.path / "report")
             summary["report"] = str(index.relative_to(run.path))
             run.mark_complete(json.loads(json.dumps(summary, default=str)))
     print(f"[lca] done {run.path}")

@@ -62,11 +62,22 @@ def test_runs_complete_with_results(sweep: Path) -> None:
 def test_per_run_report(sweep: Path) -> None:
     for policy, name in RUNS.items():
         table = pd.read_csv(sweep / name / "report" / "sim_table.csv")
-        assert set(table["policy"]) == {LABELS[policy]}
-        assert len(table) == CELLS * len(METRICS)
+        # the run's own rows and the shipped reference policy's, on the same cells and seeds
+        assert set(table["policy"]) == {LABELS[policy], "Blind (reference)"}
+        assert len(table) == 2 * CELLS * len(METRICS)
+        assert (table["n_units"] == 2).all()
         assert (sweep / name / "report" / "claim.csv").is_file()  # no pair in one run
         html = (sweep / name / "report" / "index.html").read_text()
         assert LABELS[policy] in html and 'href="../"' in html  # the run links to itself
+
+
+def test_reference_policy_is_evaluated_once_for_the_sweep(sweep: Path) -> None:
+    cached = list((sweep / ".reference").glob("blind_flat-*"))
+    assert len(cached) == 1, cached  # one evaluation, reused by the second run
+    results = pd.read_parquet(cached[0] / "results.parquet")
+    assert len(results) == 2 * 1 * CELLS  # the sweep's eval sizes: 2 units x 1 episode
+    html = (sweep / RUNS["one_mlp"] / "report" / "index.html").read_text()
+    assert "Blind (reference)" in html
 
 
 def test_sweep_report(sweep: Path) -> None:

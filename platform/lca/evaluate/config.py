@@ -9,12 +9,17 @@ from omegaconf import MISSING
 from lca.config.errors import check_range, require
 from lca.config.registry import eval_terrain_names
 from lca.config.schema import group
-from lca.paths import conf_dir
+from lca.paths import assets_dir, conf_dir
 
 
 def difficulties() -> list[str]:
     """The difficulty options (conf/difficulty/*.yaml): what an evaluation cell may name."""
     return sorted(p.stem for p in (conf_dir() / "difficulty").glob("*.yaml"))
+
+
+def shipped_policies() -> list[str]:
+    """The complete runs under assets/policies/: what `eval.reference` may name."""
+    return sorted(p.parent.name for p in (assets_dir() / "policies").glob("*/COMPLETE"))
 
 
 @dataclass
@@ -36,6 +41,9 @@ class EvalConfig:
     # rows x cols tiles of each cell's terrain: 16 draws of riser or block field per cell,
     # whatever grid the policy trained on
     grid: list[int] = field(default_factory=lambda: [4, 4])
+    # shipped policies (assets/policies/<name>) evaluated with these settings beside a run in
+    # its report, marked "(reference)"; each evaluation is cached under runs_root/.reference
+    reference: list[str] = field(default_factory=lambda: ["blind_flat"])
     cells: list[EvalCell] = field(  # stairs = half the tiles up, half down
         default_factory=lambda: [
             EvalCell(t, d) for t in ("stairs", "uneven") for d in ("medium", "hard")
@@ -57,6 +65,13 @@ class EvalConfig:
             "eval.grid",
             f"must be [rows, cols] >= 1, got {list(self.grid)}",
         )
+        shipped = shipped_policies()
+        for name in self.reference:
+            require(
+                name in shipped,
+                "eval.reference",
+                f"no shipped policy '{name}'; shipped (assets/policies/): {shipped}",
+            )
         require(
             self.video_seconds > 0, "eval.video_seconds", f"must be > 0, got {self.video_seconds}"
         )

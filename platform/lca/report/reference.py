@@ -1,0 +1,74 @@
+"""Reference rows: shipped policies (`assets/policies/<name>/`) evaluated on a run's own
+cells, seeds and sizes, so that a newcomer's first table has rows that walk beside theirs.
+
+Each evaluation is cached under `<runs_root>/.reference/<name>-<key>/`, the key a hash of the
+evaluation settings and the policy's checkpoint: every later run with the same settings
+reuses it. The cached run's rows read "<label> (reference)", never pooled with a new run's.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import fcntl
+import hashlib
+import json
+import shutil
+from pathlib import Path
+
+from omegaconf import DictConfig, OmegaConf
+
+from lca.evaluate.policy import final_checkpoint
+from lca.evaluate.run import evaluate_and_write
+from lca.paths import assets_dir
+from lca.store import COMPLETE
+
+MARK = " (reference)"
+# what a reference run carries over from the shipped one: no exports, clips or results
+KEEP = ("config.yaml", "provenance.json", "train_cfg.json", "train_curve.csv", COMPLETE)
+
+
+def reference_runs(cfg: DictConfig, log=print) -> list[Path]:
+    """The cached, evaluated copy of every policy in `cfg.eval.reference`, evaluated like
+    `cfg`'s own run (its eval settings, clips off)."""
+    cache = Path(cfg.runs_root) / ".reference"
+    return [reference_run(name, cfg.eval, cache, log) for name in cfg.eval.reference]
+
+
+def reference_run(name: str, eval_cfg: DictConfig, cache: Path, log=print) -> Path:
+    shipped = assets_dir() / "policies" / name  # eval.reference is checked at composition
+    settings = OmegaConf.to_container(eval_cfg, resolve=True)
+    settings = {k: v for k, v in settings.items() if k not in ("videos", "reference")}
+    checkpoint = final_checkpoint(shipped)
+    digest = hashlib.sha256(json.dumps(settings, sort_keys=True).encode())
+    digest.update(checkpoint.read_bytes())
+    run = cache / f"{name}-{digest.hexdigest()[:12]}"
+    cache.mkdir(parents=True, exist_ok=True)
+    with _locked(cache / f"{name}.lock"):  # parallel sweep jobs evaluate it once
+        if not (run / "summary.csv").is_file():
+            _copy(shipped, run, checkpoint, eval_cfg)
+            log(f"[lca] reference {name}: evaluating on this run's cells (cached in {run})")
+            evaluate_and_write(run, log=log)
+    return run
+
+
+def _copy(shipped: Path, run: Path, checkpoint: Path, eval_cfg: DictConfig) -> None:
+    shutil.rmtree(run, ignore_errors=True)
+    (run / "checkpoints").mkdir(parents=True)
+    for name in KEEP:
+        if (shipped / name).exists():
+            shutil.copy2(shipped / name, run / name)
+    shutil.copy2(checkpoint, run / "checkpoints" / checkpoint.name)
+    cfg = OmegaConf.load(run / "config.yaml")
+    cfg.eval = OmegaConf.merge(cfg.eval, eval_cfg, {"videos": False, "reference": []})
+    cfg.policy.label = f"{cfg.policy.label}{MARK}"
+    OmegaConf.save(cfg, run / "config.yaml")
+
+
+@contextlib.contextmanager
+def _locked(path: Path):
+    with path.open("w") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
