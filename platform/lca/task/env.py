@@ -108,6 +108,8 @@ class LocomotionEnv(VecEnv):
         self.critic_grid = tuple(obs.critic_grid)
         self.actor_offsets = heightmap.grid_offsets(self.actor_grid, obs.actor_spacing)
         self.critic_offsets = heightmap.grid_offsets(self.critic_grid, obs.critic_spacing)
+        # both grids' points, queried in one call each step (the actor's first)
+        self.map_offsets = np.concatenate([self.actor_offsets, self.critic_offsets])
 
         self.commands = VelocityCommand(task.commands, self.num_envs, self.dt, self.rng, ref)
         self.perception_cfg = OmegaConf.to_object(cfg.perception)
@@ -337,11 +339,12 @@ class LocomotionEnv(VecEnv):
             actor_current = current
         self._state = state
         yaw = yaw_of(state.base_quat)
-        actor_map = self._actor_map(state, yaw)
-        critic_raw = heightmap.sample_heights(
-            self.scene.terrain, state.base_pos[:, :2], yaw, self.critic_offsets
+        raw = heightmap.sample_heights(
+            self.scene.terrain, state.base_pos[:, :2], yaw, self.map_offsets
         )
-        critic_map = heightmap.normalise(critic_raw)
+        split = self.actor_offsets.shape[0]
+        actor_map = self._actor_map(state, yaw, raw[:, :split])
+        critic_map = heightmap.normalise(raw[:, split:])
         groups = {
             "policy": xp.concat([self.history.flat(), actor_current], axis=1),
             "height": actor_map.reshape(n, 1, *self.actor_grid),
@@ -426,13 +429,15 @@ class LocomotionEnv(VecEnv):
             device=self.device,
         )
 
-    def _actor_map(self, state: RobotState, yaw: Array) -> Array:
+    def _actor_map(self, state: RobotState, yaw: Array, raw: Array | None = None) -> Array:
+        """The actor's map; `raw`: the terrain heights under its grid, if already sampled."""
         if not self.perception:
             return self._zeros((self.num_envs, self.actor_offsets.shape[0]))
         if self.cameras is not None:
             return self._camera_map(state, yaw)
-        raw = heightmap.sample_heights(
-            self.scene.terrain, state.base_pos[:, :2], yaw, self.actor_offsets
-        )
+        if raw is None:
+            raw = heightmap.sample_heights(
+                self.scene.terrain, state.base_pos[:, :2], yaw, self.actor_offsets
+            )
         drop = self.task_cfg.observations.height_dropout
         return heightmap.actor_map(raw, self.height_noise, drop, self.rng)

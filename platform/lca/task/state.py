@@ -9,7 +9,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from lca.arrays import Array, namespace, zeros
+import numpy as np
+
+from lca.arrays import Array, device_of, namespace, zeros
 from lca.sim import robot as g1
 from lca.sim.batch import BatchedSim
 
@@ -65,17 +67,19 @@ class ContactAccumulator:
 
     def __init__(self, sim: BatchedSim):
         self.sim = sim
-        self.feet = [sim.sensor(f"{side}_foot_contact") for side in g1.FEET]
-        self.legs = [
-            sim.sensor(f"{side}_{part}_contact")
-            for side in g1.FEET
-            for part in g1.UNDESIRED_CONTACT_BODIES
+        names = [f"{side}_foot_contact" for side in g1.FEET] + [
+            f"{side}_{part}_contact" for side in g1.FEET for part in g1.UNDESIRED_CONTACT_BODIES
         ]
+        # the force columns (1-3) of every contact sensor, gathered in one take per substep
+        adr = [int(sim.scene.model.sensor(name).adr[0]) for name in names]
+        columns = np.array([a + k for a in adr for k in (1, 2, 3)], dtype=np.int64)
         self.xp = namespace(sim.qpos)  # resolved once: update runs every substep
+        self._columns = self.xp.asarray(columns, device=device_of(sim.qpos))
+        self._shape = (sim.num_envs, len(names), 3)
 
-        self.foot_force = zeros((sim.num_envs, 2), sim.qpos)
-        self.foot_lateral = zeros((sim.num_envs, 2), sim.qpos)
-        self.leg_force = zeros((sim.num_envs, len(self.legs)), sim.qpos)
+        self.foot_force = zeros((sim.num_envs, len(g1.FEET)), sim.qpos)
+        self.foot_lateral = zeros((sim.num_envs, len(g1.FEET)), sim.qpos)
+        self.leg_force = zeros((sim.num_envs, len(names) - len(g1.FEET)), sim.qpos)
 
     def clear(self) -> None:
         self.foot_force[:] = 0
@@ -84,15 +88,13 @@ class ContactAccumulator:
 
     def update(self) -> None:
         xp = self.xp
-        norm = xp.linalg.vector_norm
-        for i, sensor in enumerate(self.feet):
-            force = sensor[:, 1:4]
-            self.foot_force[:, i] = xp.maximum(self.foot_force[:, i], norm(force, axis=1))
-            lateral = norm(force[:, :2], axis=1)
-            self.foot_lateral[:, i] = xp.maximum(self.foot_lateral[:, i], lateral)
-        for i, sensor in enumerate(self.legs):
-            force = norm(sensor[:, 1:4], axis=1)
-            self.leg_force[:, i] = xp.maximum(self.leg_force[:, i], force)
+        force = xp.reshape(xp.take(self.sim.sensordata, self._columns, axis=1), self._shape)
+        magnitude = xp.linalg.vector_norm(force, axis=2)
+        feet = len(g1.FEET)
+        lateral = xp.linalg.vector_norm(force[:, :feet, :2], axis=2)
+        self.foot_force[:] = xp.maximum(self.foot_force, magnitude[:, :feet])
+        self.foot_lateral[:] = xp.maximum(self.foot_lateral, lateral)
+        self.leg_force[:] = xp.maximum(self.leg_force, magnitude[:, feet:])
 
 
 def read_state(
