@@ -122,6 +122,9 @@ def test_chromium_shows_videos_and_images(media_report: Path, tmp_path: Path) ->
     shown = chromium_media(media_report / "index.html", tmp_path / "profile")
     videos = [m for m in shown if m["tag"] == "VIDEO"]
     images = [m for m in shown if m["tag"] == "IMG"]
+    seed_figures = [m for m in images if m["src"].startswith(("seeds_", "performance_profiles"))]
+    assert seed_figures, shown  # the training-seed section's figures (report/seeds.py)
+    images = [m for m in images if m not in seed_figures]
     assert len(videos) == 2 and len(images) == 3, shown
     for item in shown:
         assert item["width"] > 0 and item["height"] > 0, item
@@ -136,7 +139,7 @@ def test_chromium_shows_videos_and_images(media_report: Path, tmp_path: Path) ->
 
 def test_runs_without_pictures_have_no_sections(fixture_report: Path) -> None:
     page = parsed(fixture_report)
-    assert not page.media or {s for s, _, _ in page.media} <= {"training"}
+    assert not page.media or {s for s, _, _ in page.media} <= {"training", "seeds"}
     html = (fixture_report / "index.html").read_text()
     assert 'id="clips"' not in html and 'id="terrains"' not in html
     assert not (fixture_report / "media").exists()

@@ -10,11 +10,14 @@ from pathlib import Path
 import pandas as pd
 
 from lca.report.collect import POOLED, find_run_dirs, load_run, run_status
-from lca.report.dashboard import hardware_section, write_dashboard
+from lca.report.dashboard import hardware_section, seeds_section, write_dashboard
 from lca.report.figures import plot_rewards
 from lca.report.hardware_table import hardware_table
 from lca.report.media import clips_section, terrains_section
+from lca.report.seed_figures import profile_figure, seed_figures
+from lca.report.seeds import improvement_table, seed_table
 from lca.report.tables import (
+    across_seed_count,
     best_mask,
     claim_table,
     long_table,
@@ -77,10 +80,13 @@ def _build(run_dirs: list[Path], excluded: pd.DataFrame, out_dir: Path, final: P
     episodes = pooled_episodes(runs)
     table = long_table(episodes) if not episodes.empty else episodes
     _mark(table, note).to_csv(out_dir / "sim_table.csv", index=False)
+    seeds = seed_table(episodes) if not episodes.empty else pd.DataFrame()
+    _mark(seeds, note).to_csv(out_dir / "seed_table.csv", index=False)
+    n_seeds = across_seed_count(seeds)
     if table.empty:
         text = best = table
     else:
-        text, means = wide_table(table)
+        text, means = wide_table(table, seeds)
         best = best_mask(means)
         notes = [f"\\textbf{{{note.replace(' - ', ' --- ')}.}}"] if note else []
         if any(r.label.endswith(POOLED) for r in runs):
@@ -88,9 +94,14 @@ def _build(run_dirs: list[Path], excluded: pd.DataFrame, out_dir: Path, final: P
                 "CNN (pooled): $2\\times2$ max-pooling after each convolution "
                 "(\\texttt{encoder.pool}), not the paper's CNN."
             )
-        (out_dir / "sim_table.tex").write_text(to_latex(text, best, " ".join(notes)))
+        (out_dir / "sim_table.tex").write_text(to_latex(text, best, " ".join(notes), n_seeds))
     claim = claim_table(runs)
     _mark(claim, note).to_csv(out_dir / "claim.csv", index=False)
+    improvement = improvement_table(runs)
+    _mark(improvement, note).to_csv(out_dir / "improvement.csv", index=False)
+    if not episodes.empty:
+        seed_figures(seeds, out_dir)
+        profile_figure(episodes, out_dir / "performance_profiles.png")
     excluded.to_csv(out_dir / "excluded_runs.csv", index=False)
     plot_rewards(runs, out_dir / "training_rewards")
     hardware_html = ""
@@ -115,4 +126,6 @@ def _build(run_dirs: list[Path], excluded: pd.DataFrame, out_dir: Path, final: P
         link_base=final,
         note=note,
         media=media,
+        seeds=seeds_section(seeds, improvement, n_seeds, out_dir) if not episodes.empty else "",
+        n_seeds=n_seeds,
     )

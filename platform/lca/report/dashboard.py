@@ -34,14 +34,14 @@ PAGE = Template(
 works; their numbers are not results.</p>{% endif %}
 <p>{{ n_runs }} run(s), {{ n_complete }} with evaluation results.</p>
 <h2 id="simulation">Simulation results</h2>
-<p>Mean ± standard deviation across units (all seeds pooled); best per column and difficulty in
-bold.
+<p>{{ sim_caption }}; best per column and difficulty in bold.
 Downloads: <a href="sim_table.tex">LaTeX</a>, <a href="sim_table.csv">CSV</a>.</p>
 {{ sim_table }}
 <h2 id="claim">Two-stage vs one-stage (paired)</h2>
 <p>Two-stage minus its one-stage twin (same actor, encoder and seed; units paired by common
 random numbers), 95 % paired bootstrap CI. <a href="claim.csv">CSV</a>.</p>
 {{ claim_table }}
+{{ seeds }}
 {{ hardware }}
 {{ media }}
 <h2 id="training">Training rewards</h2>
@@ -133,6 +133,8 @@ def write_dashboard(
     link_base: Path | None = None,
     note: str = "",
     media: str = "",
+    seeds: str = "",
+    n_seeds: int = 0,
 ) -> Path:
     """index.html in `out_dir`; run links are relative to `link_base` (default out_dir), the
     folder the page will finally live in. `media`: the clips and terrains sections (HTML)."""
@@ -151,7 +153,55 @@ def write_dashboard(
         excluded=excluded_section(excluded),
         note=note,
         media=media,
+        seeds=seeds,
+        sim_caption=(
+            "IQM across training seeds [95 % stratified bootstrap CI, units resampled within each "
+            "seed]"
+            if n_seeds >= 2
+            else "Mean ± standard deviation across units (all seeds pooled)"
+        ),
     )
     path = out_dir / "index.html"
     path.write_text(page)
     return path
+
+
+def seeds_section(seeds: pd.DataFrame, improvement: pd.DataFrame, n_seeds: int, out_dir) -> str:
+    """Training seeds: per-seed values, mean and IQM across seeds with stratified bootstrap
+    CIs, the probability of improvement, and the seed and performance-profile figures. With
+    one seed it says so and claims nothing across seeds."""
+    if n_seeds < 2:
+        head = (
+            "<p>One training seed per policy (at least one row): the tables show the spread "
+            "across units; no confidence interval across seeds can be computed. Declare "
+            "<code>seed=0,1,2</code> (or an experiment's <code>seeds:</code>) for one.</p>"
+        )
+    else:
+        head = (
+            f"<p>At least {n_seeds} training seeds per row: each seed's mean over units, their "
+            "mean and interquartile mean (IQM) with 95 % stratified bootstrap CIs (units "
+            'resampled within each seed). <a href="seed_table.csv">CSV</a>.</p>'
+        )
+    table = seeds.round(3).to_html(index=False, table_id="seed-table")
+    figures = "".join(
+        f'<figure><img src="{p.name}" alt="{html.escape(p.stem)}"></figure>'
+        for p in sorted(Path(out_dir).glob("seeds_*.png"))
+    )
+    pairs = (
+        "<p>Two-stage against one-stage over the seeds both have: each seed's difference of "
+        "means (better = more success, fewer contacts), whether its sign agrees across seeds, "
+        "and P(two-stage better) over units, averaged over seeds, with its stratified CI. "
+        '<a href="improvement.csv">CSV</a>.</p>'
+        + improvement.round(3).to_html(index=False, table_id="improvement-table")
+        if not improvement.empty
+        else ""
+    )
+    return (
+        '<h2 id="seeds">Training seeds</h2>\n'
+        + head
+        + table
+        + pairs
+        + figures
+        + '<h3>Performance profiles</h3><img src="performance_profiles.png" '
+        'alt="performance profiles">'
+    )
