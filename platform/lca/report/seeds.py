@@ -134,8 +134,9 @@ IMPROVEMENT_METRICS = {"success": 1.0, "contacts_per_step": -1.0}  # sign of "be
 
 def improvement_table(runs: list) -> pd.DataFrame:
     """Two-stage against its one-stage twin (same actor and encoder) over the seeds both
-    have, per cell: each seed's difference of means, their mean, whether the sign agrees
-    across seeds (NaN with one seed), and P(two-stage better) with its stratified CI."""
+    have, per cell: each seed's difference of means (positive: two-stage better), their mean,
+    whether every seed's difference has the same nonzero sign (NaN with one seed), and
+    P(two-stage better) with its stratified CI."""
     pools: dict[tuple, dict[int, pd.DataFrame]] = {}
     labels = {}
     for run in runs:
@@ -171,7 +172,10 @@ def improvement_table(runs: list) -> pd.DataFrame:
                         "metric": metric,
                         "n_seeds": len(seeds),
                         "mean_diff": float(np.mean(diffs)),
-                        "sign_agrees": (len(signs) == 1) if len(seeds) > 1 else np.nan,
+                        # one nonzero sign in every seed (all-zero differences agree on nothing)
+                        "sign_agrees": (len(signs) == 1 and 0 not in signs)
+                        if len(seeds) > 1
+                        else np.nan,
                         "p_improvement": probability_of_improvement(x, y),
                         **dict(
                             zip(
