@@ -22,6 +22,7 @@ SWEEP = [
     "eval.units=2",
     "eval.episodes=1",
     "eval.steps=10",
+    "eval.reference=[blind_flat]",  # the default job's reference rows (scale=smoke: none)
     "logger=none",
     "torch_threads=1",
     "sim.num_threads=1",

@@ -100,7 +100,8 @@ def _build(run_dirs: list[Path], excluded: pd.DataFrame, out_dir: Path, final: P
     improvement = improvement_table(runs)
     _mark(improvement, note).to_csv(out_dir / "improvement.csv", index=False)
     if not episodes.empty:
-        seed_figures(seeds, out_dir)
+        if seeds["n_seeds"].max() >= 2:  # one seed per row: single points, nothing to show
+            seed_figures(seeds, out_dir)
         profile_figure(episodes, out_dir / "performance_profiles.png")
     excluded.to_csv(out_dir / "excluded_runs.csv", index=False)
     plot_rewards(runs, out_dir / "training_rewards")
