@@ -242,3 +242,16 @@ def chromium_media(index: Path, profile: Path) -> list[dict]:
     found = re.search(r'<pre id="lca-measured">(.*?)</pre>', out.stdout, re.S)
     assert found, f"the page never finished loading its media: {out.stdout[-1500:]}"
     return json.loads(html.unescape(found.group(1)))
+
+
+def run_sweep(root: Path, args: list[str], runs: int, timeout: int = 600) -> Path:
+    """`python run.py <args>` into `root/runs`; checks that `runs` runs finished and that the
+    sweep report was built. Returns the run store."""
+    runs_root = root / "runs"
+    out = run_python(
+        str(REPO / "run.py"), *args, f"runs_root={runs_root}", cwd=root, timeout=timeout
+    )
+    assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
+    assert out.stdout.count("[lca] done") == runs, out.stdout
+    assert f"[lca] sweep report: {runs_root / 'report' / 'index.html'}" in out.stdout
+    return runs_root

@@ -9,7 +9,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from .helpers import REPO, run_python
+from .helpers import run_sweep
 
 pytestmark = [pytest.mark.slow, pytest.mark.e2e]
 
@@ -30,12 +30,7 @@ SWEEP = [
 
 @pytest.fixture(scope="module")
 def sweep(tmp_path_factory) -> Path:
-    root = tmp_path_factory.mktemp("seeds")
-    runs_root = root / "runs"
-    out = run_python(str(REPO / "run.py"), *SWEEP, f"runs_root={runs_root}", cwd=root, timeout=600)
-    assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
-    assert out.stdout.count("[lca] done") == 6, out.stdout
-    return runs_root
+    return run_sweep(tmp_path_factory.mktemp("seeds"), SWEEP, runs=6, timeout=600)
 
 
 def test_one_run_per_seed(sweep: Path) -> None:

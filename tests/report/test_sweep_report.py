@@ -11,7 +11,7 @@ import pytest
 
 from lca.evaluate.metrics import METRICS
 
-from .helpers import REPO, cell_units, run_python
+from .helpers import cell_units, run_sweep
 
 pytestmark = [pytest.mark.slow, pytest.mark.e2e]  # run.py end to end: see README
 
@@ -37,13 +37,7 @@ CELLS = 4
 
 @pytest.fixture(scope="module")
 def sweep(tmp_path_factory) -> Path:
-    root = tmp_path_factory.mktemp("sweep")
-    runs_root = root / "runs"
-    out = run_python(str(REPO / "run.py"), *SWEEP, f"runs_root={runs_root}", cwd=root, timeout=300)
-    assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
-    assert out.stdout.count("[lca] done") == 2, out.stdout
-    assert f"[lca] sweep report: {runs_root / 'report' / 'index.html'}" in out.stdout
-    return runs_root
+    return run_sweep(tmp_path_factory.mktemp("sweep"), SWEEP, runs=2, timeout=300)
 
 
 def test_runs_complete_with_results(sweep: Path) -> None:
