@@ -3,10 +3,12 @@
 python run.py -m actor=mlp,lstm curriculum=one,two
 """
 
+import traceback
 from pathlib import Path
 
 import hydra
 from hydra.core.hydra_config import HydraConfig
+from hydra.types import RunMode
 from omegaconf import DictConfig
 
 import lca.config
@@ -21,12 +23,19 @@ def main(cfg: DictConfig) -> dict | None:
     lca.config.validate(cfg)
     hydra_cfg = HydraConfig.get()
     label_policy(cfg, hydra_cfg.searchpath)
-    return run_pipeline(
-        cfg,
-        Path(hydra_cfg.runtime.output_dir),
-        list(hydra_cfg.overrides.task),
-        dict(hydra_cfg.runtime.choices),
-    )
+    run_dir = Path(hydra_cfg.runtime.output_dir)
+    try:
+        return run_pipeline(
+            cfg, run_dir, list(hydra_cfg.overrides.task), dict(hydra_cfg.runtime.choices)
+        )
+    except Exception as error:
+        if hydra_cfg.mode != RunMode.MULTIRUN:
+            raise
+        # one failed run of a sweep: its FAILED marker says why, the others go on, and the
+        # sweep report lists it under "Runs left out" (the sweep then exits non-zero)
+        traceback.print_exc()
+        print(f"[lca] failed {run_dir}: {type(error).__name__}: {error}")
+        return None
 
 
 if __name__ == "__main__":

@@ -8,6 +8,7 @@ missing episode round.
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 from omegaconf import DictConfig
@@ -24,6 +25,7 @@ def run_pipeline(
 ) -> dict | None:
     run = RunDir(run_path)
     with run.lock():  # a second process on this run fails here, naming the owner
+        link_job_logs(run.path)  # a cluster job's log, even when it only skips the run
         if run.complete and not cfg.force:
             print(f"[lca] skip {run.path} (complete; force=true re-runs it)")
             return None
@@ -47,3 +49,18 @@ def run_pipeline(
             run.mark_complete(json.loads(json.dumps(summary, default=str)))
     print(f"[lca] done {run.path}")
     return summary
+
+
+def link_job_logs(run_dir: Path) -> None:
+    """Under SLURM (the submitit launcher), link the job's stdout and stderr into the run
+    directory as `slurm-<job id>.out` / `.err`: one pair per try of a requeued job."""
+    if "SLURM_JOB_ID" not in os.environ or "SUBMITIT_FOLDER" not in os.environ:
+        return
+    import submitit
+
+    job = submitit.JobEnvironment()
+    Path(run_dir).mkdir(parents=True, exist_ok=True)
+    for source, suffix in ((job.paths.stdout, "out"), (job.paths.stderr, "err")):
+        link = Path(run_dir) / f"slurm-{job.job_id}.{suffix}"
+        if not link.is_symlink():
+            link.symlink_to(Path(source).resolve())

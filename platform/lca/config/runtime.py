@@ -23,6 +23,13 @@ def run_name(override_dirname: str) -> str:
     return override_dirname or "default"
 
 
+def gpus_for(device: str) -> int:
+    """GPUs a cluster job asks for: one when the run's torch device is `cuda`, else none."""
+    return 1 if str(device).startswith("cuda") else 0
+
+
 def register_resolvers() -> None:
     if not OmegaConf.has_resolver("lca_run_name"):
         OmegaConf.register_new_resolver("lca_run_name", run_name)
+    if not OmegaConf.has_resolver("lca_gpus"):
+        OmegaConf.register_new_resolver("lca_gpus", gpus_for)
