@@ -66,7 +66,7 @@ start() {
   pgrep -x slurmctld >/dev/null || slurmctld
   pgrep -x slurmd >/dev/null || slurmd
   local waited=0
-  until sinfo -h -o %T 2>/dev/null | grep -q idle; do
+  until timeout 5 sinfo -h -o %T 2>/dev/null | grep -q idle; do
     if [ "$waited" -ge "$WAIT_S" ]; then
       echo "slurm_local: the node is not idle after ${WAIT_S} s:" >&2
       sinfo >&2 || true
@@ -76,15 +76,21 @@ start() {
     sleep 1
     waited=$((waited + 1))
     # a node left DOWN or DRAINED by an earlier run comes back
-    scontrol update nodename="$(hostname -s)" state=resume >/dev/null 2>&1 || true
+    timeout 5 scontrol update nodename="$(hostname -s)" state=resume >/dev/null 2>&1 || true
   done
   echo "slurm_local: node $(hostname -s) idle after ${waited} s ($(nproc) CPUs)"
 }
 
 stop() {
-  pkill -x slurmd || true
-  pkill -x slurmctld || true
-  pkill -x munged || true
+  local name waited
+  for name in slurmd slurmctld munged; do
+    pkill -x "$name" || true
+    waited=0  # gone before a later start looks for it
+    while pgrep -x "$name" >/dev/null && [ "$waited" -lt 20 ]; do
+      sleep 0.5
+      waited=$((waited + 1))
+    done
+  done
 }
 
 case "${1:-}" in
