@@ -83,6 +83,8 @@ def main(argv: list[str] | None = None) -> int:
     spec = load_experiment(args.file)
     roots, extra = split_option(args.overrides, "runs_root")
     runs_root = roots[-1] if roots else spec["runs_root"]
+    launchers, extra = split_option(extra, "hydra/launcher")  # the command line's wins
+    spec["launcher"] = launchers[-1] if launchers else spec["launcher"]
     if args.dry_run:
         plan = list(itertools.product(spec["policies"], spec["seeds"]))
         for policy, seed in plan:

@@ -80,6 +80,13 @@ def test_dry_run_overrides_change_the_cost(paper_plan: str) -> None:
     assert "runs_root=/tmp/elsewhere" in out.split("command: ", 1)[1]
 
 
+def test_dry_run_on_a_cluster_takes_the_command_line_launcher() -> None:
+    out = _dry_run("--dry-run", str(PAPER_SIM), "hydra/launcher=slurm")
+    assert "21 runs into runs/paper_sim/ with launcher 'slurm'" in out
+    command = out.split("command: ", 1)[1]
+    assert "hydra/launcher=slurm" in command and "hydra/launcher=local" not in command
+
+
 def test_dry_run_documented_argument_order() -> None:
     out = run_python("-m", "lca.experiment", str(PAPER_SIM), "--dry-run", "scale=smoke", cwd=REPO)
     assert out.returncode == 0, out.stderr
