@@ -59,14 +59,20 @@ CONF
   chmod 400 /etc/munge/munge.key
 }
 
+# a live process of this name (a daemon killed hard can linger as a zombie: not running)
+running() {
+  ps -C "$1" -o stat= 2>/dev/null | grep -qv '^Z'
+}
+
 start() {
   install
   configure
-  pgrep -x munged >/dev/null || su -s /bin/sh munge -c "/usr/sbin/munged --force"
-  pgrep -x slurmctld >/dev/null || slurmctld
-  pgrep -x slurmd >/dev/null || slurmd
-  local waited=0
+  running munged || su -s /bin/sh munge -c "/usr/sbin/munged --force"
+  running slurmctld || slurmctld
+  running slurmd || slurmd
+  local began=$SECONDS waited=0
   until timeout 5 sinfo -h -o %T 2>/dev/null | grep -q idle; do
+    waited=$((SECONDS - began))
     if [ "$waited" -ge "$WAIT_S" ]; then
       echo "slurm_local: the node is not idle after ${WAIT_S} s:" >&2
       sinfo >&2 || true
@@ -74,11 +80,10 @@ start() {
       exit 1
     fi
     sleep 1
-    waited=$((waited + 1))
     # a node left DOWN or DRAINED by an earlier run comes back
     timeout 5 scontrol update nodename="$(hostname -s)" state=resume >/dev/null 2>&1 || true
   done
-  echo "slurm_local: node $(hostname -s) idle after ${waited} s ($(nproc) CPUs)"
+  echo "slurm_local: node $(hostname -s) idle after $((SECONDS - began)) s ($(nproc) CPUs)"
 }
 
 stop() {
@@ -86,7 +91,7 @@ stop() {
   for name in slurmd slurmctld munged; do
     pkill -x "$name" || true
     waited=0  # gone before a later start looks for it
-    while pgrep -x "$name" >/dev/null && [ "$waited" -lt 20 ]; do
+    while running "$name" && [ "$waited" -lt 20 ]; do
       sleep 0.5
       waited=$((waited + 1))
     done
