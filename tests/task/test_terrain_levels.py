@@ -129,3 +129,27 @@ def test_levels_run_on_torch_tensors():
     levels.update(torch.arange(8), xy, torch.full((8, 2), 0.5))  # others stood: held at 0
     assert levels.level.tolist() == [1, 1, 1, 1, 0, 0, 0, 0]
     assert torch.allclose(sim.env_origin[:4, 1], torch.tensor(1.5 * cfg.terrain.tile_size))
+
+
+def test_turning_walker_moves_up_by_its_path_and_a_stuck_one_moves_down(levelled):
+    """A walker on a circle ends near its spawn, and a commanded speed that changes mid-episode
+    asks for its mean: the path walked and the mean command decide, not straight lines."""
+    _, env = levelled
+    levels = env.terrain_levels
+    xy = _place(env, 1)
+    dt, steps = 0.02, int(levels.episode_s / 0.02)
+    radius, speed = 1.2, 0.4  # a 7.5 m circle walked in 18.8 s: ~one lap in the episode
+    for k in range(1, steps + 1):
+        t = k * dt
+        angle = speed * t / radius
+        pos = xy.copy()
+        pos[0:4, 0] += radius * np.sin(angle)
+        pos[0:4, 1] += radius * (1 - np.cos(angle))
+        pos[4:8, 0] += 0.01 * np.sin(8 * t)  # stepping in place, swaying 1 cm
+        command = np.full((8, 2), [speed, 0.0])
+        command[:, 0] = speed if t < 10 else 0.1  # the last command is slow
+        levels.track(pos, command, dt)
+    assert np.linalg.norm(pos[0] - xy[0]) < levels.tile_size / 2  # straight line: not up
+    levels.update(np.arange(8), pos, command)
+    assert list(levels.level) == [2, 2, 2, 2, 0, 0, 0, 0]
+    assert np.all(levels.path == 0) and np.all(levels.lived == 0)  # the next episode afresh

@@ -167,12 +167,12 @@ def cell_grid(terrain: Terrain) -> CellGrid:
 def _cell_index(x: Array, lookup: tuple, xp) -> Array:
     """Index of the cell holding x: 0 before the first line, len(lines) past the last."""
     start, inverse, bucket, lower, upper = lookup
-    k = xp.clip(
-        xp.astype(xp.floor((x - start) * inverse), xp.int64), min=0, max=bucket.shape[0] - 1
-    )
+    # truncation, not floor: they differ only below 0, which the clip maps to bucket 0 anyway
+    k = xp.clip(xp.astype((x - start) * inverse, xp.int64), min=0, max=bucket.shape[0] - 1)
     i = xp.take(bucket, k)
-    i = i + xp.astype(x >= xp.take(upper, i), xp.int64)
-    return i - xp.astype(x < xp.take(lower, i), xp.int64)
+    i += xp.astype(x >= xp.take(upper, i), xp.int64)
+    i -= xp.astype(x < xp.take(lower, i), xp.int64)
+    return i
 
 
 def _lookup(lines: np.ndarray, bucket: np.ndarray, resolution: float, on, xp) -> tuple:

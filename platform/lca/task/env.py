@@ -163,6 +163,8 @@ class LocomotionEnv(VecEnv):
             self.sim.step()
             self.contacts.update()
         self._episode_steps += 1
+        if self.terrain_levels is not None:
+            self.terrain_levels.track(self.sim.qpos[:, :2], self.commands.value[:, :2], self.dt)
         self._maybe_push()
         self.commands.update()
 
@@ -339,11 +341,11 @@ class LocomotionEnv(VecEnv):
             actor_current = current
         self._state = state
         yaw = yaw_of(state.base_quat)
-        raw = heightmap.sample_heights(
-            self.scene.terrain, state.base_pos[:, :2], yaw, self.map_offsets
-        )
-        split = self.actor_offsets.shape[0]
-        actor_map = self._actor_map(state, yaw, raw[:, :split])
+        # the actor's points only when its map is read from the terrain (not blind, no cameras)
+        split = self.actor_offsets.shape[0] if self.perception and self.cameras is None else 0
+        offsets = self.map_offsets if split else self.critic_offsets
+        raw = heightmap.sample_heights(self.scene.terrain, state.base_pos[:, :2], yaw, offsets)
+        actor_map = self._actor_map(state, yaw, raw[:, :split] if split else None)
         critic_map = heightmap.normalise(raw[:, split:])
         groups = {
             "policy": xp.concat([self.history.flat(), actor_current], axis=1),

@@ -18,6 +18,7 @@ from lca.arrays import copy_of, like, rng_state, set_rng_state
 
 ARRAYS = ("_episode_steps", "action", "last_action")
 COUNTERS = ("nonfinite_resets", "nonfinite_actions", "penalty_scale", "only_positive")
+LEVEL_TRACKS = ("path", "asked", "lived", "mark")  # TerrainLevels' per-episode distances
 
 
 def env_state(env) -> dict:
@@ -50,7 +51,7 @@ def env_state(env) -> dict:
         state["terrain_levels"] = {
             "level": copy_of(levels.level),
             "origin": copy_of(sim.env_origin),
-        }
+        } | {name: copy_of(getattr(levels, name)) for name in LEVEL_TRACKS}
     if env.cameras is not None:
         state["camera"] = {"frame": env._camera_frame.copy(), "map": env._deployment_map.copy()}
     return state
@@ -88,6 +89,9 @@ def restore_env_state(env, state: dict) -> None:
     if state.get("terrain_levels") is not None:
         env.terrain_levels.level[:] = state["terrain_levels"]["level"]
         sim.env_origin[:] = state["terrain_levels"]["origin"]
+        for name in LEVEL_TRACKS:  # states saved before the tracks existed start them at 0
+            if name in state["terrain_levels"]:
+                getattr(env.terrain_levels, name)[:] = state["terrain_levels"][name]
     env.perception = state["perception"]
     for key, value in state["obs"].items():
         env._obs[key] = value.to(env.device)

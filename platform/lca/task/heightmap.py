@@ -31,9 +31,10 @@ def sample_heights(terrain: Terrain, base_xy: Array, yaw: Array, offsets: Array)
     """(N, P) terrain heights at offsets rotated by each base's yaw (NumPy or torch)."""
     xp = namespace(base_xy, yaw)
     offsets = like(offsets, base_xy)
-    cos, sin = xp.cos(yaw)[:, None], xp.sin(yaw)[:, None]
-    x = base_xy[:, :1] + cos * offsets[None, :, 0] - sin * offsets[None, :, 1]
-    y = base_xy[:, 1:2] + sin * offsets[None, :, 0] + cos * offsets[None, :, 1]
+    heading = xp.stack([xp.cos(yaw), xp.sin(yaw)], axis=1)  # (N, 2)
+    # x = bx + cos ox - sin oy, y = by + sin ox + cos oy: two (N, 2) @ (2, P) products
+    x = base_xy[:, :1] + heading @ xp.stack([offsets[:, 0], -offsets[:, 1]])
+    y = base_xy[:, 1:2] + heading @ xp.stack([offsets[:, 1], offsets[:, 0]])
     return terrain.height_at(x, y)
 
 

@@ -116,6 +116,9 @@ def read_state(
     base_pos = copy(qpos[:, :3])
     foot_pos = xp.stack([sensor(f"{s}_foot_pos") for s in g1.FEET], axis=1)
     foot_quat = xp.stack([sensor(f"{s}_foot_quat") for s in g1.FEET], axis=1)
+    # the ground under the base and each foot, in one query: (N, 1 + feet)
+    points = xp.concat([base_pos[:, None, :2], foot_pos[..., :2]], axis=1)
+    ground = height_at(points[..., 0], points[..., 1])
     return RobotState(
         base_pos=base_pos,
         base_quat=copy(qpos[:, 3:7]),
@@ -123,7 +126,7 @@ def read_state(
         base_lin_vel_world=copy(sensor("base_lin_vel_world")),
         base_ang_vel=copy(sensor("imu_ang_vel")),
         projected_gravity=-sensor("imu_up"),
-        base_height=base_pos[:, 2] - height_at(base_pos[:, 0], base_pos[:, 1]),
+        base_height=base_pos[:, 2] - ground[:, 0],
         joint_pos=copy(qpos[:, sim.joint_qpos]),
         joint_vel=copy(qvel[:, sim.joint_dof]),
         joint_acc=copy(sim.qacc[rows][:, sim.joint_dof]),
@@ -131,7 +134,7 @@ def read_state(
         foot_pos=foot_pos,
         foot_vel=xp.stack([sensor(f"{s}_foot_lin_vel") for s in g1.FEET], axis=1),
         foot_pitch=pitch_of(foot_quat),
-        foot_height=foot_pos[..., 2] - height_at(foot_pos[..., 0], foot_pos[..., 1]),
+        foot_height=foot_pos[..., 2] - ground[:, 1:],
         foot_force=copy(contacts.foot_force[rows]),
         foot_lateral_force=copy(contacts.foot_lateral[rows]),
         leg_contact_force=copy(contacts.leg_force[rows]),
