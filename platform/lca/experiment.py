@@ -2,9 +2,12 @@
 
     python -m lca.experiment experiments/paper_sim.yaml --dry-run [overrides]
     python -m lca.experiment experiments/paper_sim.yaml [overrides]
+    python -m lca.experiment experiments/reference.yaml --evaluate-only [overrides]
 
 The file lists named policies (conf/policy/), seeds, overrides and a launcher; the multirun
-writes one run directory per (policy, seed) under runs/<name>/ and the report when it ends.
+writes one run directory per (policy, seed) under runs/<name>/ and the report when it ends;
+complete runs are skipped. `--evaluate-only` trains nothing: it evaluates the policies the
+file ships (`lca.shipped`) and rebuilds its report.
 """
 
 from __future__ import annotations
@@ -78,6 +81,11 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m lca.experiment")
     parser.add_argument("file", type=Path)
     parser.add_argument("--dry-run", action="store_true", help="print the plan and its cost")
+    parser.add_argument(
+        "--evaluate-only",
+        action="store_true",
+        help="evaluate the shipped policies (no training) and rebuild the file's report",
+    )
     parser.add_argument("overrides", nargs="*")
     args = parser.parse_intermixed_args(argv)
     spec = load_experiment(args.file)
@@ -85,6 +93,10 @@ def main(argv: list[str] | None = None) -> int:
     runs_root = roots[-1] if roots else spec["runs_root"]
     launchers, extra = split_option(extra, "hydra/launcher")  # the command line's wins
     spec["launcher"] = launchers[-1] if launchers else spec["launcher"]
+    if args.evaluate_only:
+        from lca.shipped import evaluate_only
+
+        return evaluate_only(spec, spec["overrides"] + extra, Path(REPO, runs_root))
     if args.dry_run:
         plan = list(itertools.product(spec["policies"], spec["seeds"]))
         for policy, seed in plan:

@@ -62,3 +62,45 @@ def test_critic_warmup_trains_the_critic_only(tmp_path, smoke_scene) -> None:
     resumed.train()
     assert not torch.equal(resumed.alg.actor.state_dict()[weight], actor0[weight])
     assert all(p.requires_grad for p in resumed.alg.actor.parameters())
+
+
+@pytest.mark.slow  # trains: see README
+@pytest.mark.parametrize("encoder", ["mlp", "cnn"])
+def test_a_blind_start_acts_the_same_and_its_map_has_no_say(tmp_path, smoke_scene, encoder):
+    """Issue 28's common start: a blind MLP-encoder policy's networks start a perceptive one
+    of either encoder; its actions and values equal the source's, whatever the map says."""
+    donor_cfg = smoke_cfg("scale.max_iterations=2", "policy=blind")
+    donor = make_trainer(donor_cfg, tmp_path / "donor", smoke_scene)
+    donor.train()
+    source = tmp_path / "donor" / "checkpoints" / "latest.pt"
+    cfg = smoke_cfg(
+        f"encoder={encoder}",
+        "curriculum=one",
+        f"algo.init_from={source}",
+        "algo.init_map_zero=true",
+    )
+    warm = make_trainer(cfg, tmp_path / "warm", smoke_scene)
+    obs = warm.env.get_observations()
+    flat, bumpy = obs.clone(), obs.clone()
+    flat["height"] = torch.zeros_like(obs["height"])
+    flat["critic_height"] = torch.zeros_like(obs["critic_height"])
+    bumpy["height"] = torch.rand_like(obs["height"])
+    bumpy["critic_height"] = torch.rand_like(obs["critic_height"])
+    with torch.no_grad():
+        expected = donor.alg.actor(flat, stochastic_output=False)
+        value = donor.alg.critic(flat)
+        for sees in (flat, bumpy):
+            torch.testing.assert_close(warm.alg.actor(sees, stochastic_output=False), expected)
+            torch.testing.assert_close(warm.alg.critic(sees), value)
+    first = warm.alg.actor.state_dict()["mlp.0.weight"]
+    assert torch.all(first[:, -warm.alg.actor._z_dim :] == 0)
+
+
+def test_map_zero_start_needs_a_blind_mlp_encoder_source(tmp_path) -> None:
+    from lca.learn.warm_start import encoder_at_zero
+
+    conv = {"encoder.net.0.weight": torch.zeros(4, 1, 3, 3), "encoder.net.0.bias": torch.zeros(4)}
+    with pytest.raises(ValueError, match="not an MLP"):
+        encoder_at_zero(conv, "elu")
+    with pytest.raises(ValueError, match="no encoder"):
+        encoder_at_zero({"mlp.0.weight": torch.zeros(2, 2)}, "elu")

@@ -153,3 +153,18 @@ def test_turning_walker_moves_up_by_its_path_and_a_stuck_one_moves_down(levelled
     levels.update(np.arange(8), pos, command)
     assert list(levels.level) == [2, 2, 2, 2, 0, 0, 0, 0]
     assert np.all(levels.path == 0) and np.all(levels.lived == 0)  # the next episode afresh
+
+
+def test_when_the_curriculum_is_over_every_reset_goes_to_the_top_row(levelled):
+    _, env = levelled
+    levels = env.terrain_levels
+    xy = _place(env, 1)
+    levels.over = True
+    levels.update(np.arange(8), xy, np.full((8, 2), 0.5))  # stood: would move down
+    levels.over = False
+    assert np.all(levels.level == 3) and np.all(_row_of(env, np.arange(8)) == 3)
+
+
+def test_levels_end_must_be_a_fraction():
+    with pytest.raises(ValueError, match="terrain.levels_end"):
+        compose([*LEVELLED, "terrain.levels_end=1.5"])

@@ -13,6 +13,8 @@ from pathlib import Path
 import torch
 
 from lca.learn import curriculum
+from lca.learn.warm_start import zero_map_state
+from lca.paths import root
 from lca.store import write_atomically
 from lca.task.env_state import env_state, restore_env_state
 
@@ -90,12 +92,25 @@ class Checkpoints:
     def _warm_start(self, path: Path) -> None:
         """Networks (and their observation normalisers and action std) from `path`; the
         optimizer, iteration and every schedule start afresh."""
+        if not path.is_absolute() and not path.exists():  # a path inside the checkout
+            path = root() / path
         if not path.is_file():
             raise FileNotFoundError(f"algo.init_from: no checkpoint at {path}")
-        self.runner.load(
-            str(path), load_cfg={"actor": True, "critic": True}, map_location=self.device
+        if not self.cfg.algo.init_map_zero:
+            self.runner.load(
+                str(path), load_cfg={"actor": True, "critic": True}, map_location=self.device
+            )
+            print(f"[lca] {self.run.path.name} starts from the networks of {path}")
+            return
+        saved = torch.load(path, map_location=self.device, weights_only=False)
+        for name in ("actor", "critic"):
+            model = getattr(self.alg, name)
+            source = saved[f"{name}_state_dict"]
+            model.load_state_dict(zero_map_state(source, model, self.cfg.actor.activation))
+        print(
+            f"[lca] {self.run.path.name} starts from the networks of {path}, "
+            "its map's contribution zero"
         )
-        print(f"[lca] {self.run.path.name} starts from the networks of {path}")
 
     def _load_newest_readable(self) -> dict | None:
         """Load the newest checkpoint that reads (latest, then previous), saying what was

@@ -108,6 +108,10 @@ class AlgoConfig:
     # a checkpoint whose actor and critic start this run (a warm start): its optimizer and
     # iteration are not loaded, so every schedule starts at iteration 0. "": from scratch
     init_from: str = ""
+    # with init_from: the map contributes nothing at first (lca.learn.warm_start): a blind
+    # MLP-encoder source's zero-map features folded into the first layer's bias, their weights
+    # zero, the encoder fresh; any encoder (mlp, cnn) can start so. false: a strict load
+    init_map_zero: bool = False
     # iterations at the start that train the critic only (the actor frozen, the learning rate
     # fixed): a warm start's critic first learns the new run's returns. 0: none
     critic_warmup: int = 0

@@ -33,6 +33,7 @@ def build_train_cfg(cfg: DictConfig, run_name: str) -> dict:
     num_steps = algo.pop("num_steps_per_env")
     algo.pop("init_from")  # read by the trainer, not by PPO
     algo.pop("critic_warmup")
+    algo.pop("init_map_zero")
     obs_normalization = algo.pop("obs_normalization")
     symmetry_cfg = None
     mirror_loss = algo.pop("mirror_loss_coeff")

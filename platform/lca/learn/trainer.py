@@ -213,6 +213,8 @@ class Trainer(Checkpoints):
             self.rewards.update(it, float(length) / env.max_episode_length, float(progress))
             env.set_reward_shaping(*self.rewards.shaping)
             env.commands.min_speed = self.commands.floor(it)
+            if env.terrain_levels is not None:
+                env.terrain_levels.over = it >= cfg.terrain.levels_end * self.total
             env.commands.ranges = self.commands.ranges(it, cfg.task.commands)
             ceiling = noise_ceiling(cfg.actor, it, self.total, self.rewards.progress)
             apply_ceiling(actor, ceiling)

@@ -133,6 +133,9 @@ class TerrainConfig:
     # half their commanded distance, and past the top row restart on a random one
     levels: bool = False
     max_init_level: int = 0  # envs start on rows 0..this (IsaacLab: 5 of 10)
+    # fraction of the run from which the curriculum is over: every env resets onto the top
+    # row, the configured difficulty itself (1.0: never, IsaacLab's way)
+    levels_end: float = 1.0
     platform: float = 1.5  # m, flat square at each tile centre where the robot spawns
     num_steps: int = 8  # steps per pyramid side (stairs_up / stairs_down)
     block_size: float = 0.4  # m, side of a block of the uneven field
@@ -171,6 +174,11 @@ class TerrainConfig:
             0 <= self.max_init_level < self.rows,
             "terrain.max_init_level",
             f"must be in [0, rows - 1 = {self.rows - 1}], got {self.max_init_level}",
+        )
+        require(
+            0 <= self.levels_end <= 1,
+            "terrain.levels_end",
+            f"must be a fraction of the run in [0, 1], got {self.levels_end}",
         )
 
 

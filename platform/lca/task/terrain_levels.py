@@ -34,6 +34,7 @@ class TerrainLevels:
         n, device = int(origin.shape[0]), device_of(origin)
         self.column = xp.arange(n, device=device) % self.cols
         self.level = self._uniform_rows(terrain_cfg.max_init_level + 1, n)
+        self.over = False  # the curriculum has ended: every reset goes to the top row
         self.path, self.asked, self.lived = (
             xp.zeros(n, dtype=origin.dtype, device=device) for _ in range(3)
         )
@@ -69,6 +70,8 @@ class TerrainLevels:
         level = self.level[ids] + xp.astype(up, xp.int64) - xp.astype(down, xp.int64)
         restart = self._uniform_rows(self.rows, int(ids.shape[0]))
         self.level[ids] = xp.where(level >= self.rows, restart, xp.clip(level, min=0))
+        if self.over:
+            self.level[ids] = self.rows - 1
         self._place(ids)
 
     def mean(self) -> float:

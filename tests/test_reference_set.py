@@ -1,0 +1,80 @@
+"""The reference set (issue 28): experiments/reference.yaml, `scale=reference`, and
+`python -m lca.experiment <file> --evaluate-only` on shipped policies."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pandas as pd
+import pytest
+from omegaconf import OmegaConf
+
+from lca import experiment
+from lca.config import compose
+from lca.paths import root
+
+REFERENCE = root() / "experiments" / "reference.yaml"
+BLIND_FLAT = root() / "assets" / "policies" / "blind_flat"
+
+
+def test_the_file_states_the_budget_the_recipe_trains():
+    spec = OmegaConf.to_container(OmegaConf.load(REFERENCE))
+    for policy in spec["policies"]:
+        cfg = compose([f"policy={policy}", *spec["overrides"]])
+        steps = cfg.scale.max_iterations * cfg.algo.num_steps_per_env * cfg.task.num_envs
+        assert steps == spec["budget_env_steps"], policy
+        assert cfg.terrain.name == "mixed" and cfg.seed == 0
+        assert cfg.eval.units >= 128 and cfg.eval.episodes >= 2 and cfg.eval.steps >= 1000
+    # the common warm start of the decision rule ships with the repository
+    start = compose(spec["overrides"]).algo.init_from
+    assert (root() / start).is_file()
+
+
+def test_every_policy_uses_the_paper_cnn_and_full_body_collisions():
+    cfg = compose(["policy=two_cnn", "scale=reference"])
+    assert cfg.encoder.pool == 0
+    assert set(cfg.robot.collision_parts) == {"feet", "legs", "torso", "arms"}
+
+
+def _ship(shipped: Path, name: str) -> None:
+    """A copy of the flat walker shipped as `name`: the blind MLP's networks are those of an
+    MLP-encoder policy of any curriculum (its encoder untrained)."""
+    folder = shipped / name
+    shutil.copytree(BLIND_FLAT, folder, ignore=shutil.ignore_patterns("*.onnx", "*.jit", "*.pt2"))
+    cfg = OmegaConf.load(folder / "config.yaml")
+    named = compose([f"policy={name}"])
+    cfg.curriculum, cfg.policy = named.curriculum, named.policy
+    OmegaConf.save(cfg, folder / "config.yaml")
+
+
+@pytest.mark.slow  # evaluates: see README
+def test_evaluate_only_reports_two_shipped_policies(tmp_path):
+    shipped = tmp_path / "shipped"
+    shipped.mkdir()
+    shutil.copytree(BLIND_FLAT, shipped / "blind")
+    _ship(shipped, "two_mlp")
+    spec = OmegaConf.to_container(OmegaConf.load(REFERENCE))
+    spec |= {"shipped": str(shipped), "report": str(tmp_path / "report"), "hardware": False}
+    spec["overrides"] = ["scale=smoke", "eval.units=4", "eval.steps=30"]
+    file = tmp_path / "reference.yaml"
+    OmegaConf.save(OmegaConf.create(spec), file)
+
+    code = experiment.main([str(file), "--evaluate-only", f"runs_root={tmp_path / 'runs'}"])
+    assert code == 0
+    report = tmp_path / "report"
+    table = pd.read_csv(report / "sim_table.csv")
+    assert list(dict.fromkeys(table["policy"])) == ["Blind", "Two-Stage MLP"]
+    cells = {(t, d) for t in ("stairs", "uneven") for d in ("medium", "hard")}
+    metrics = {"success", "contacts_per_step", "track_cm_s"}
+    for _, rows in table.groupby("policy"):
+        assert set(zip(rows["terrain"], rows["difficulty"], strict=True)) == cells
+        assert set(rows["metric"]) == metrics and (rows["n_units"] == 4).all()
+    assert (report / "claim.csv").is_file()  # the paired two-stage - one-stage comparison
+    assert (report / "sim_table.tex").is_file() and (report / "index.html").is_file()
+    training = pd.read_csv(report / "training.csv")
+    assert list(training["policy"]) == ["blind", "two_mlp"]
+    curve = pd.read_csv(BLIND_FLAT / "train_curve.csv").iloc[-1]
+    assert training["env_steps"].tolist() == [int(curve["env_steps"])] * 2
+    # the policies not shipped are named, not fatal
+    assert (tmp_path / "runs" / "evaluated" / "blind" / "summary.csv").is_file()
