@@ -78,3 +78,18 @@ def test_evaluate_only_reports_two_shipped_policies(tmp_path):
     assert training["env_steps"].tolist() == [int(curve["env_steps"])] * 2
     # the policies not shipped are named, not fatal
     assert (tmp_path / "runs" / "evaluated" / "blind" / "summary.csv").is_file()
+
+
+def test_a_shipped_policy_is_not_trained_again(tmp_path, capsys):
+    shipped = tmp_path / "shipped"
+    (shipped / "blind").mkdir(parents=True)
+    (shipped / "blind" / "COMPLETE").touch()
+    spec = OmegaConf.to_container(OmegaConf.load(REFERENCE))
+    spec |= {"shipped": str(shipped)}
+    file = tmp_path / "reference.yaml"
+    OmegaConf.save(OmegaConf.create(spec), file)
+    assert experiment.main([str(file), "--dry-run"]) == 0
+    out = capsys.readouterr().out
+    assert "shipped already, not trained again: blind" in out
+    planned = [line.split()[0] for line in out.splitlines() if line.startswith("  policy=")]
+    assert planned == [f"policy={p}" for p in spec["policies"] if p != "blind"]

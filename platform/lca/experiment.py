@@ -97,6 +97,16 @@ def main(argv: list[str] | None = None) -> int:
         from lca.shipped import evaluate_only
 
         return evaluate_only(spec, spec["overrides"] + extra, Path(REPO, runs_root))
+    if "shipped" in spec:  # a policy that ships is not trained again
+        from lca.shipped import shipped_policies
+
+        done = shipped_policies(spec)
+        if done:
+            print(f"[lca] shipped already, not trained again: {', '.join(done)}")
+        spec["policies"] = [p for p in spec["policies"] if p not in done]
+        if not spec["policies"]:
+            print("[lca] every policy ships: nothing to train (--evaluate-only reports them)")
+            return 0
     if args.dry_run:
         plan = list(itertools.product(spec["policies"], spec["seeds"]))
         for policy, seed in plan:

@@ -36,6 +36,12 @@ def shipped_dir(spec: dict) -> Path:
     return root() / spec.get("shipped", "assets/policies")
 
 
+def shipped_policies(spec: dict) -> list[str]:
+    """The policies of `spec` that ship complete under its `shipped` folder."""
+    shipped = shipped_dir(spec)
+    return [p for p in spec["policies"] if (shipped / p / COMPLETE).exists()]
+
+
 def evaluated_copy(policy: str, shipped: Path, out: Path, overrides: list[str]) -> Path:
     """A fresh run directory `out` holding `shipped`'s policy, with the evaluation and
     hardware settings of `policy=<policy> <overrides>`."""
@@ -85,7 +91,7 @@ def _run_steps(run: Path) -> int:
 def evaluate_only(spec: dict, overrides: list[str], runs_root: Path, log=print) -> int:
     """Evaluate every shipped policy of `spec`, then build its report. Returns an exit code."""
     shipped = shipped_dir(spec)
-    found = {p: shipped / p for p in spec["policies"] if (shipped / p / COMPLETE).exists()}
+    found = {p: shipped / p for p in shipped_policies(spec)}
     missing = [p for p in spec["policies"] if p not in found]
     if not found:
         log(

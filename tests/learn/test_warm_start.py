@@ -104,3 +104,12 @@ def test_map_zero_start_needs_a_blind_mlp_encoder_source(tmp_path) -> None:
         encoder_at_zero(conv, "elu")
     with pytest.raises(ValueError, match="no encoder"):
         encoder_at_zero({"mlp.0.weight": torch.zeros(2, 2)}, "elu")
+
+
+def test_map_zero_start_refuses_a_recurrent_actor() -> None:
+    from types import SimpleNamespace
+
+    from lca.learn.warm_start import zero_map_state
+
+    with pytest.raises(ValueError, match="recurrent actor"):
+        zero_map_state({}, SimpleNamespace(is_recurrent=True), "elu")

@@ -51,6 +51,11 @@ def zero_map_state(
     tensor but the encoder's and the first layer's as the source has it, the first layer with
     the source's zero-map features folded into its bias and zero weights on the features, the
     encoder as `target` was initialised. Raises naming the first tensor that does not fit."""
+    if getattr(target, "is_recurrent", False):
+        raise ValueError(
+            "algo.init_map_zero: the common start is an MLP actor's; a recurrent actor "
+            "(actor=lstm) cannot start from it: train it from scratch (algo.init_from='')"
+        )
     own = target.state_dict()
     z0 = encoder_at_zero(source, activation)
     weight_key, bias_key = f"{FIRST_LAYER}.weight", f"{FIRST_LAYER}.bias"
