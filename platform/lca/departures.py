@@ -68,4 +68,6 @@ def _text(value: Any) -> str:
         return "{" + ", ".join(f"{k}: {_text(v)}" for k, v in value.items()) + "}"
     if isinstance(value, float):
         return f"{value:g}"
+    if value == "":
+        return "none"  # e.g. algo.init_from: from scratch
     return str(value)
