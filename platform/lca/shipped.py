@@ -13,7 +13,6 @@ hardware-style tasks, and the report is built into the file's `report` folder to
 from __future__ import annotations
 
 import json
-import shutil
 import time
 from pathlib import Path
 
@@ -26,10 +25,8 @@ from lca.evaluate.policy import final_checkpoint, load_run_config
 from lca.evaluate.run import evaluate_and_write
 from lca.paths import root
 from lca.report.build import build_report
+from lca.report.reference import copy_run
 from lca.store import COMPLETE
-
-# what an evaluated copy carries over from the shipped policy: no exports, clips or results
-KEEP = ("config.yaml", "provenance.json", "train_cfg.json", "train_curve.csv", COMPLETE)
 
 
 def shipped_dir(spec: dict) -> Path:
@@ -46,17 +43,8 @@ def evaluated_copy(policy: str, shipped: Path, out: Path, overrides: list[str]) 
     """A fresh run directory `out` holding `shipped`'s policy, with the evaluation and
     hardware settings of `policy=<policy> <overrides>`."""
     composed = compose([f"policy={policy}", *overrides])
-    checkpoint = final_checkpoint(shipped)
-    shutil.rmtree(out, ignore_errors=True)
-    (out / "checkpoints").mkdir(parents=True)
-    for name in KEEP:
-        if (shipped / name).exists():
-            shutil.copy2(shipped / name, out / name)
-    shutil.copy2(checkpoint, out / "checkpoints" / checkpoint.name)
-    cfg = OmegaConf.load(out / "config.yaml")
-    cfg.eval = OmegaConf.merge(cfg.eval, composed.eval, {"reference": []})
-    cfg.hardware = composed.hardware
-    OmegaConf.save(cfg, out / "config.yaml")
+    evaluation = OmegaConf.merge(composed.eval, {"reference": []})
+    copy_run(shipped, out, final_checkpoint(shipped), eval=evaluation, hardware=composed.hardware)
     return out
 
 

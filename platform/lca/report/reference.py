@@ -25,6 +25,7 @@ from lca.store import COMPLETE
 MARK = " (reference)"
 # what a reference run carries over from the shipped one: no exports, clips or results
 KEEP = ("config.yaml", "provenance.json", "train_cfg.json", "train_curve.csv", COMPLETE)
+NO_MEDIA = {"videos": False, "reference": []}
 
 
 def reference_runs(cfg: DictConfig, log=print) -> list[Path]:
@@ -52,6 +53,15 @@ def reference_run(name: str, eval_cfg: DictConfig, cache: Path, log=print) -> Pa
 
 
 def _copy(shipped: Path, run: Path, checkpoint: Path, eval_cfg: DictConfig) -> None:
+    copy_run(shipped, run, checkpoint, eval=OmegaConf.merge(eval_cfg, NO_MEDIA))
+    cfg = OmegaConf.load(run / "config.yaml")
+    cfg.policy.label = f"{cfg.policy.label}{MARK}"
+    OmegaConf.save(cfg, run / "config.yaml")
+
+
+def copy_run(shipped: Path, run: Path, checkpoint: Path, **settings) -> None:
+    """A fresh run directory `run` holding `shipped`'s files of KEEP and `checkpoint`, each
+    top-level config group of `settings` merged into its config."""
     shutil.rmtree(run, ignore_errors=True)
     (run / "checkpoints").mkdir(parents=True)
     for name in KEEP:
@@ -59,8 +69,8 @@ def _copy(shipped: Path, run: Path, checkpoint: Path, eval_cfg: DictConfig) -> N
             shutil.copy2(shipped / name, run / name)
     shutil.copy2(checkpoint, run / "checkpoints" / checkpoint.name)
     cfg = OmegaConf.load(run / "config.yaml")
-    cfg.eval = OmegaConf.merge(cfg.eval, eval_cfg, {"videos": False, "reference": []})
-    cfg.policy.label = f"{cfg.policy.label}{MARK}"
+    for key, value in settings.items():
+        cfg[key] = OmegaConf.merge(cfg[key], value)
     OmegaConf.save(cfg, run / "config.yaml")
 
 
