@@ -254,3 +254,25 @@ def test_huge_velocity_reset_by_mujoco_is_detected(mixed_env, dof):
     assert done[1] == 1
     assert env.nonfinite_resets == resets + 1
     assert_fresh(env, obs, np.array([1]))
+
+
+@pytest.mark.parametrize("perception", [False, True])
+def test_without_the_critic_the_actor_sees_the_same(make_env, perception):
+    """Evaluation turns the critic's observations off (`observe_critic`): the actor's
+    observations stay bit for bit what they are with them, step after step."""
+    envs = [make_env(*MIXED, "task.observations.noise=true")[1] for _ in range(2)]
+    envs[1].observe_critic = False
+    obs = []
+    for env in envs:
+        env.set_perception(perception)
+        env.reseed(3)
+        obs.append(env.reset_all())
+    actions = torch.from_numpy(np.random.default_rng(0).uniform(-1, 1, (4, 8, J))).float()
+    for step in range(len(actions) + 1):
+        assert set(obs[1].keys()) == {"policy", "height"}
+        for group in ("policy", "height"):
+            torch.testing.assert_close(obs[1][group], obs[0][group], rtol=0, atol=0)
+        if perception:
+            assert obs[1]["height"].abs().sum() > 0
+        if step < len(actions):
+            obs = [env.step(actions[step])[0] for env in envs]

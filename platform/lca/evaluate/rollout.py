@@ -14,7 +14,9 @@ from lca.task.env import LocomotionEnv
 
 
 def start(env: LocomotionEnv, policy) -> TensorDict:
-    """Every unit reset (and the policy's memory with it); the first observations."""
+    """Every unit reset (and the policy's memory with it); the first observations. A test
+    of a policy reads the actor's observations only: the env stops building the critic's."""
+    env.observe_critic = False
     obs = env.reset_all()
     policy.reset(torch.ones(env.num_envs, dtype=torch.bool, device=env.device))
     return obs

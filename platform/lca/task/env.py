@@ -96,6 +96,8 @@ class LocomotionEnv(VecEnv):
         self.scaled_terms = frozenset(task.reward_curriculum.terms) or None
         self.unclipped = frozenset(task.reward_curriculum.unclipped)
         self.perception = bool(task.perception)
+        # evaluation turns it off: only the actor's observations (no critic map, no history)
+        self.observe_critic = True
         self.height_noise = float(cfg.difficulty.height_noise) if task.observations.noise else 0.0
 
         obs = task.observations
@@ -329,11 +331,12 @@ class LocomotionEnv(VecEnv):
         noisy = self.task_cfg.observations.noise
         clean = observations.build(inputs, self.history_terms, None)
         frame = observations.build(inputs, self.history_terms, self.rng) if noisy else clean
-        self.history.push(frame)
-        self.critic_history.push(clean)
         fresh = self._all_ids() if reset_ids is None else reset_ids
+        self.history.push(frame)
         self.history.fill(fresh, frame)
-        self.critic_history.fill(fresh, clean)
+        if self.observe_critic:
+            self.critic_history.push(clean)
+            self.critic_history.fill(fresh, clean)
         current = observations.build(inputs, self.current_terms, None)
         if noisy and any(t.noise > 0 for t in self.current_terms):
             actor_current = observations.build(inputs, self.current_terms, self.rng)
@@ -343,18 +346,24 @@ class LocomotionEnv(VecEnv):
         yaw = yaw_of(state.base_quat)
         # the actor's points only when its map is read from the terrain (not blind, no cameras)
         split = self.actor_offsets.shape[0] if self.perception and self.cameras is None else 0
-        offsets = self.map_offsets if split else self.critic_offsets
-        raw = heightmap.sample_heights(self.scene.terrain, state.base_pos[:, :2], yaw, offsets)
-        actor_map = self._actor_map(state, yaw, raw[:, :split] if split else None)
-        critic_map = heightmap.normalise(raw[:, split:])
+        if self.observe_critic:
+            offsets = self.map_offsets if split else self.critic_offsets
+            raw = heightmap.sample_heights(self.scene.terrain, state.base_pos[:, :2], yaw, offsets)
+        else:
+            raw = None
+        actor_map = self._actor_map(
+            state, yaw, raw[:, :split] if split and raw is not None else None
+        )
         groups = {
             "policy": xp.concat([self.history.flat(), actor_current], axis=1),
             "height": actor_map.reshape(n, 1, *self.actor_grid),
-            "critic": xp.concat(
-                [self.critic_history.flat(), current, state.base_lin_vel_world], axis=1
-            ),
-            "critic_height": critic_map.reshape(n, 1, *self.critic_grid),
         }
+        if self.observe_critic:
+            groups["critic"] = xp.concat(
+                [self.critic_history.flat(), current, state.base_lin_vel_world], axis=1
+            )
+            critic_map = heightmap.normalise(raw[:, split:])
+            groups["critic_height"] = critic_map.reshape(n, 1, *self.critic_grid)
         return TensorDict(
             {
                 k: torch.as_tensor(v, dtype=torch.float32, device=self.device)

@@ -1,0 +1,121 @@
+"""The README's "Results" block, written from a report folder beside the paper's numbers:
+
+    python -m lca.report.results reports/reference
+
+prints two Markdown tables (success and contacts/step per cell, "ours (paper)") and the paired
+two-stage - one-stage differences with their CIs. The README carries that block verbatim
+between `<!-- results:begin -->` and `<!-- results:end -->`; tests/test_quoted_figures.py
+regenerates it from the files and compares, so a number in the README is always the file's.
+The paper's numbers are its simulation table (`assets/paper/sim_table.csv`).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+from lca.paths import assets_dir
+from lca.report.collect import row_key
+
+BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
+CELLS = [  # the paper's four cells, then flat (not in the paper's table)
+    ("stairs", "medium"),
+    ("uneven", "medium"),
+    ("stairs", "hard"),
+    ("uneven", "hard"),
+    ("flat", "medium"),
+]
+DIGITS = {"success": 1, "contacts_per_step": 2, "track_cm_s": 1}
+CLAIMS = [  # (terrain, difficulty, metric) the paper's claims rest on
+    ("uneven", "hard", "success"),
+    ("stairs", "medium", "contacts_per_step"),
+    ("stairs", "hard", "contacts_per_step"),
+]
+
+
+def paper_table() -> pd.DataFrame:
+    return pd.read_csv(assets_dir() / "paper" / "sim_table.csv")
+
+
+def _means(table: pd.DataFrame, policy_col: str = "policy") -> dict[tuple, float]:
+    keys = zip(table[policy_col], table.terrain, table.difficulty, table.metric, strict=True)
+    return dict(zip(keys, table["mean"], strict=True))
+
+
+def metric_table(ours: pd.DataFrame, paper: pd.DataFrame, metric: str) -> str:
+    """Markdown: one row per policy of `ours`, one column per cell, "ours (paper)"."""
+    mine, theirs = _means(ours), _means(paper)
+    cells = [c for c in CELLS if any(k[1:3] == c for k in mine)]
+    head = ["Policy", *(f"{t} {d}" for t, d in cells)]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for policy in sorted(ours.policy.unique(), key=row_key):
+        row = [policy]
+        for terrain, difficulty in cells:
+            value = mine.get((policy, terrain, difficulty, metric))
+            text = "–" if value is None else f"{value:.{DIGITS[metric]}f}"
+            quoted = theirs.get((policy, terrain, difficulty, metric))
+            row.append(text if quoted is None else f"{text} ({quoted:g})")
+        lines.append("| " + " | ".join(row) + " |")
+    return "\n".join(lines)
+
+
+def claim_lines(claim: pd.DataFrame) -> str:
+    """One bullet per twin pair and claim cell: the paired difference and its 95 % CI."""
+    lines = []
+    for terrain, difficulty, metric in CLAIMS:
+        rows = claim[
+            (claim.terrain == terrain) & (claim.difficulty == difficulty) & (claim.metric == metric)
+        ]
+        unit = "points" if metric == "success" else "points of contacts/step"
+        for r in rows.itertuples(index=False):
+            lines.append(
+                f"- {r.two_stage} − {r.one_stage}, {terrain} {difficulty}: "
+                f"{r.diff:+.1f} {unit} [{r.ci_low:+.1f}, {r.ci_high:+.1f}]"
+            )
+    return "\n".join(lines) or "- no two-stage policy has its one-stage twin in this report"
+
+
+def results_block(report: Path) -> str:
+    """The README's Results block, markers included."""
+    report = Path(report)
+    ours = pd.read_csv(report / "sim_table.csv")
+    paper = paper_table()
+    claim = pd.read_csv(report / "claim.csv")
+    parts = [
+        BEGIN,
+        "Success (%), ours (paper):",
+        "",
+        metric_table(ours, paper, "success"),
+        "",
+        "Contacts/step (%), ours (paper):",
+        "",
+        metric_table(ours, paper, "contacts_per_step"),
+        "",
+        "Two-stage − one-stage, paired over the same units (95 % bootstrap CI):",
+        "",
+        claim_lines(claim),
+        END,
+    ]
+    return "\n".join(parts)
+
+
+def readme_block(text: str) -> str | None:
+    """The Results block a README carries, markers included (None without one)."""
+    if BEGIN not in text or END not in text:
+        return None
+    return text[text.index(BEGIN) : text.index(END) + len(END)]
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = sys.argv[1:] if argv is None else argv
+    if len(args) != 1:
+        print("usage: python -m lca.report.results <report folder>", file=sys.stderr)
+        return 2
+    print(results_block(Path(args[0])))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
