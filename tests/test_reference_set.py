@@ -60,7 +60,9 @@ def test_evaluate_only_reports_two_shipped_policies(tmp_path):
     file = tmp_path / "reference.yaml"
     OmegaConf.save(OmegaConf.create(spec), file)
 
-    code = experiment.main([str(file), "--evaluate-only", f"runs_root={tmp_path / 'runs'}"])
+    # two policies at once, each in a process of its own (the reference file's setting)
+    runs = f"runs_root={tmp_path / 'runs'}"
+    code = experiment.main([str(file), "--evaluate-only", "--jobs", "2", runs])
     assert code == 0
     report = tmp_path / "report"
     table = pd.read_csv(report / "sim_table.csv")
@@ -76,8 +78,9 @@ def test_evaluate_only_reports_two_shipped_policies(tmp_path):
     assert list(training["policy"]) == ["blind", "two_mlp"]
     curve = pd.read_csv(BLIND_FLAT / "train_curve.csv").iloc[-1]
     assert training["env_steps"].tolist() == [int(curve["env_steps"])] * 2
-    # the policies not shipped are named, not fatal
     assert (tmp_path / "runs" / "evaluated" / "blind" / "summary.csv").is_file()
+    evaluated = OmegaConf.load(tmp_path / "runs" / "evaluated" / "two_mlp" / "config.yaml")
+    assert evaluated.sim.num_threads == 1
 
 
 def test_a_shipped_policy_is_not_trained_again(tmp_path, capsys):

@@ -86,6 +86,13 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="evaluate the shipped policies (no training) and rebuild the file's report",
     )
+    parser.add_argument(
+        "--jobs",
+        type=int,
+        default=None,
+        help="with --evaluate-only: policies evaluated at once (default: the file's "
+        "evaluate_jobs, else 1)",
+    )
     parser.add_argument("overrides", nargs="*")
     args = parser.parse_intermixed_args(argv)
     spec = load_experiment(args.file)
@@ -96,7 +103,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.evaluate_only:
         from lca.shipped import evaluate_only
 
-        return evaluate_only(spec, spec["overrides"] + extra, Path(REPO, runs_root))
+        return evaluate_only(spec, spec["overrides"] + extra, Path(REPO, runs_root), jobs=args.jobs)
     if "shipped" in spec:  # a policy that ships is not trained again
         from lca.shipped import shipped_policies
 

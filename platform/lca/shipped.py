@@ -8,18 +8,25 @@ given the evaluation and hardware settings the experiment composes for it (the s
 seeds and sizes for every policy), evaluated (tables' results, clips), run through the
 hardware-style tasks, and the report is built into the file's `report` folder together with
 `training.csv`: each policy's environment steps and wall-clock, as its run recorded them.
+
+With `jobs` > 1 (`--jobs`, or the file's `evaluate_jobs`) that many policies are evaluated at
+once, each in a process of its own with one torch and one physics thread: on 2 cores two such
+processes outrun one with two threads, because each one's Python work (observations, rewards,
+inference) runs while the other steps its physics (reports/benchmarks.md).
 """
 
 from __future__ import annotations
 
 import json
+import multiprocessing
 import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import pandas as pd
 from omegaconf import OmegaConf
 
-from lca.config import compose
+from lca.config import compose, set_torch_threads
 from lca.evaluate.hardware import run_hardware
 from lca.evaluate.policy import final_checkpoint, load_run_config
 from lca.evaluate.run import evaluate_and_write
@@ -39,13 +46,46 @@ def shipped_policies(spec: dict) -> list[str]:
     return [p for p in spec["policies"] if (shipped / p / COMPLETE).exists()]
 
 
-def evaluated_copy(policy: str, shipped: Path, out: Path, overrides: list[str]) -> Path:
+def evaluated_copy(
+    policy: str, shipped: Path, out: Path, overrides: list[str], threads: int = 0
+) -> Path:
     """A fresh run directory `out` holding `shipped`'s policy, with the evaluation and
-    hardware settings of `policy=<policy> <overrides>`."""
+    hardware settings of `policy=<policy> <overrides>` (and `threads` physics threads)."""
     composed = compose([f"policy={policy}", *overrides])
     evaluation = OmegaConf.merge(composed.eval, {"reference": []})
-    copy_run(shipped, out, final_checkpoint(shipped), eval=evaluation, hardware=composed.hardware)
+    sim = {"num_threads": threads} if threads else {}
+    copy_run(
+        shipped,
+        out,
+        final_checkpoint(shipped),
+        eval=evaluation,
+        hardware=composed.hardware,
+        sim=sim,
+    )
     return out
+
+
+def evaluate_shipped(
+    policy: str,
+    shipped: Path,
+    out: Path,
+    overrides: list[str],
+    hardware: bool = True,
+    threads: int = 0,
+    log=print,
+) -> float:
+    """Evaluate one shipped policy into `out` (its tables' results, clips, hardware-style
+    tasks). `threads` > 0 pins torch and the physics to that many threads. Returns seconds."""
+    t0 = time.perf_counter()
+    if threads:
+        set_torch_threads(threads)
+    run = evaluated_copy(policy, shipped, out, overrides, threads)
+    evaluate_and_write(run, log=log)
+    if hardware:
+        run_hardware(run, load_run_config(run), log=log)
+    seconds = time.perf_counter() - t0
+    log(f"[lca] {policy}: evaluated in {seconds:.0f} s")
+    return seconds
 
 
 def training_table(runs: dict[str, Path]) -> pd.DataFrame:
@@ -76,8 +116,11 @@ def _run_steps(run: Path) -> int:
     return int(pd.read_csv(curve).iloc[-1]["env_steps"]) if curve.exists() else 0
 
 
-def evaluate_only(spec: dict, overrides: list[str], runs_root: Path, log=print) -> int:
-    """Evaluate every shipped policy of `spec`, then build its report. Returns an exit code."""
+def evaluate_only(
+    spec: dict, overrides: list[str], runs_root: Path, log=print, jobs: int | None = None
+) -> int:
+    """Evaluate every shipped policy of `spec`, `jobs` at a time (default: the file's
+    `evaluate_jobs`, else 1), then build its report. Returns an exit code."""
     shipped = shipped_dir(spec)
     found = {p: shipped / p for p in shipped_policies(spec)}
     missing = [p for p in spec["policies"] if p not in found]
@@ -89,22 +132,33 @@ def evaluate_only(spec: dict, overrides: list[str], runs_root: Path, log=print) 
         return 1
     if missing:
         log(f"[lca] --evaluate-only: not shipped yet, left out: {', '.join(missing)}")
+    jobs = min(int(jobs or spec.get("evaluate_jobs", 1)), len(found))
+    if jobs < 1:
+        raise ValueError(f"--jobs / evaluate_jobs: must be >= 1, got {jobs}")
     t0 = time.perf_counter()
-    runs = {}
-    for policy, folder in found.items():
-        run = evaluated_copy(policy, folder, runs_root / "evaluated" / policy, overrides)
-        t1 = time.perf_counter()
-        evaluate_and_write(run, log=log)
-        if spec.get("hardware", True):
-            run_hardware(run, load_run_config(run), log=log)
-        log(f"[lca] {policy}: evaluated in {time.perf_counter() - t1:.0f} s")
-        runs[policy] = run
+    runs = {p: runs_root / "evaluated" / p for p in found}
+    hardware = bool(spec.get("hardware", True))
+    if jobs == 1:
+        for policy, folder in found.items():
+            evaluate_shipped(policy, folder, runs[policy], overrides, hardware, log=log)
+    else:
+        log(f"[lca] --evaluate-only: {len(found)} policies, {jobs} at a time, 1 thread each")
+        # spawn: a fork of a process that already ran torch's thread pool can deadlock
+        context = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(jobs, mp_context=context) as pool:
+            futures = [
+                pool.submit(evaluate_shipped, p, f, runs[p], overrides, hardware, 1)
+                for p, f in found.items()
+            ]
+            for future in futures:
+                future.result()  # a policy's failure fails the command
     report = root() / spec.get("report", f"reports/{spec['name']}")
     index = build_report(list(runs.values()), report)
     training_table(runs).to_csv(report / "training.csv", index=False)
     seconds = time.perf_counter() - t0
     (report / "evaluate_only.json").write_text(
-        json.dumps({"policies": list(runs), "seconds": round(seconds, 1)}, indent=1) + "\n"
+        json.dumps({"policies": list(runs), "jobs": jobs, "seconds": round(seconds, 1)}, indent=1)
+        + "\n"
     )
     log(f"[lca] report: {index} ({len(runs)} policies, {seconds / 60:.1f} min)")
     return 0
