@@ -34,3 +34,19 @@ def test_every_changed_training_setting_is_listed_with_both_values() -> None:
     assert "task.reward_curriculum.enabled=True (paper: False)" in found
     # the study's axes and bookkeeping are not departures
     assert not any(line.startswith(("seed", "eval.", "actor.name", "scale.name")) for line in found)
+
+
+def test_derived_inside_a_running_hydra_app() -> None:
+    """run.py's job writes its provenance inside `@hydra.main`: the paper profile still
+    composes there, and the app's global Hydra is left as it was."""
+    from hydra import initialize_config_dir
+    from hydra.core.global_hydra import GlobalHydra
+
+    from lca.paths import conf_dir
+
+    with initialize_config_dir(config_dir=str(conf_dir()), version_base="1.3"):
+        app = GlobalHydra.instance().hydra
+        found = departures(compose(["policy=blind", "scale=reference"]))
+        assert GlobalHydra.instance().hydra is app
+    assert not any(line.startswith("not derived") for line in found), found
+    assert "algo.init_map_zero=True (paper: False)" in found

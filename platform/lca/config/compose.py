@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import contextlib
 from functools import cache
 
 from hydra import compose as hydra_compose
 from hydra import initialize_config_dir
+from hydra.core.global_hydra import GlobalHydra
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from omegaconf import DictConfig, OmegaConf
 
@@ -79,11 +81,26 @@ def load_option(group: str, name: str) -> DictConfig:
 def compose(overrides: list[str] | None = None, config_name: str = "config") -> DictConfig:
     """Compose `conf/config.yaml` with Hydra overrides, then validate it."""
     schema.register()
-    with initialize_config_dir(config_dir=str(conf_dir()), version_base="1.3"):
+    with (
+        _outside_running_app(),
+        initialize_config_dir(config_dir=str(conf_dir()), version_base="1.3"),
+    ):
         cfg = hydra_compose(config_name=config_name, overrides=list(overrides or []))
     validate(cfg)
     label_policy(cfg, searchpath(overrides or []))
     return cfg
+
+
+@contextlib.contextmanager
+def _outside_running_app():
+    """Inside `@hydra.main` (run.py's job: its provenance composes the paper profile) the
+    global Hydra is the app's: set it aside for this composition, then give it back."""
+    hydra = GlobalHydra.instance().hydra
+    GlobalHydra.instance().clear()
+    try:
+        yield
+    finally:
+        GlobalHydra.instance().hydra = hydra
 
 
 def searchpath(overrides: list[str]) -> list[str]:
