@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 from lca.paths import root
+from lca.report import results
 
 # "<success> % success, <track> cm/s tracking" quoted for a policy, and where it ships
 QUOTE = re.compile(r"(\d+(?:\.\d+)?) % success, (\d+\.\d+) cm/s tracking")
@@ -34,3 +35,28 @@ def test_quoted_flat_cell_figures_match_the_shipped_summary(doc: str, policy: st
         assert float(success) == pytest.approx(metrics["success"], abs=0.5), (doc, success)
         decimals = len(track.split(".")[1])
         assert float(track) == round(metrics["track_cm_s"], decimals), (doc, track)
+
+
+def test_the_readme_results_are_the_reference_report_beside_the_paper() -> None:
+    """The README's Results block is exactly what `python -m lca.report.results` writes from
+    reports/reference/ and the paper's table: every number in it is a file's."""
+    block = results.readme_block((root() / "README.md").read_text())
+    assert block is not None, "README.md has no Results block (lca.report.results markers)"
+    assert block == results.results_block(root() / "reports" / "reference")
+
+
+PAPER = root().parent / "shared" / "reference" / "paper.tex"
+
+
+@pytest.mark.skipif(not PAPER.exists(), reason="the paper is not beside the checkout")
+def test_the_papers_numbers_are_its_simulation_table() -> None:
+    tex = PAPER.read_text()
+    start = tex.index(r"\label{tab:sim_results_two_tasks}")
+    body = tex[start : tex.index(r"\end{tabular}", start)]
+    paper = results.paper_table()
+    quoted = {f"{v:g}" for v in paper["mean"]} | {f"{v:g}" for v in paper["sd"].dropna()}
+    in_tex = {f"{float(x):g}" for x in re.findall(r"\d+\.\d+", body)}
+    assert quoted == in_tex
+    assert len(paper) == 14 * 6  # 7 policies x 2 difficulties x 2 terrains x 3 metrics
+    row = paper[(paper.policy == "Two-Stage CNN") & (paper.difficulty == "hard")]
+    assert row.set_index(["terrain", "metric"])["mean"].to_dict()[("uneven", "success")] == 71.95

@@ -96,3 +96,12 @@ def test_a_shipped_policy_is_not_trained_again(tmp_path, capsys):
     assert "shipped already, not trained again: blind" in out
     planned = [line.split()[0] for line in out.splitlines() if line.startswith("  policy=")]
     assert planned == [f"policy={p}" for p in spec["policies"] if p != "blind"]
+
+
+def test_the_default_job_shows_the_shipped_reference_policies() -> None:
+    """The default job's report has the flat walker's rows and the reference set's blind
+    policy's, each under its own label."""
+    cfg = compose([])
+    assert list(cfg.eval.reference) == ["blind_flat", "blind"]
+    for name in cfg.eval.reference:
+        assert (root() / "assets" / "policies" / name / "COMPLETE").is_file(), name

@@ -86,3 +86,15 @@ def test_train_bench_splits_an_iteration_and_measures_its_baseline(monkeypatch) 
     assert result["baseline"]["learning_epochs"] == 5  # rsl-rl's default, the baseline
     text = train.table(result)
     assert "target: update <= 25 % of an iteration" in text and "baseline" in text
+
+
+def test_evaluate_bench_times_one_and_two_policies_at_a_time() -> None:
+    from lca.bench import evaluate
+
+    small = ["scale=smoke", "eval.units=2", "eval.steps=10", "eval.videos=false"]
+    small.append("eval.cells=[{terrain: flat, difficulty: medium}]")
+    result = evaluate.run(["shipped=blind_flat,blind_flat", *small], log=None)
+    assert list(result["policies"]) == ["blind", "one_mlp"]  # the reference file's names
+    assert result["jobs1_s"] > 0 and result["jobs2_s"] > 0
+    assert result["speedup"] == pytest.approx(result["jobs1_s"] / result["jobs2_s"])
+    assert "2 at a time, 1 thread each" in evaluate.table(result)

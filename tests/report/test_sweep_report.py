@@ -58,7 +58,7 @@ def test_per_run_report(sweep: Path) -> None:
     for policy, name in RUNS.items():
         table = pd.read_csv(sweep / name / "report" / "sim_table.csv")
         # the run's own rows and the shipped reference policy's, on the same cells and seeds
-        assert set(table["policy"]) == {LABELS[policy], "Blind (reference)"}
+        assert set(table["policy"]) == {LABELS[policy], "Blind (reference: blind_flat)"}
         assert len(table) == 2 * CELLS * len(METRICS)
         assert (table["n_units"] == 2).all()
         assert (sweep / name / "report" / "claim.csv").is_file()  # no pair in one run
@@ -72,7 +72,7 @@ def test_reference_policy_is_evaluated_once_for_the_sweep(sweep: Path) -> None:
     results = pd.read_parquet(cached[0] / "results.parquet")
     assert len(results) == 2 * 1 * CELLS  # the sweep's eval sizes: 2 units x 1 episode
     html = (sweep / RUNS["one_mlp"] / "report" / "index.html").read_text()
-    assert "Blind (reference)" in html
+    assert "Blind (reference: blind_flat)" in html
 
 
 def test_sweep_report(sweep: Path) -> None:

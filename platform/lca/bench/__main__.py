@@ -9,7 +9,7 @@ import sys
 
 from lca.paths import reports_dir
 
-BENCHMARKS = ("sim", "env", "train", "learn", "walk", "levers", "clips", "report")
+BENCHMARKS = ("sim", "env", "train", "learn", "walk", "levers", "clips", "report", "evaluate")
 
 
 def result_name(name: str, result: dict) -> str:

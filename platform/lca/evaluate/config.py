@@ -42,8 +42,9 @@ class EvalConfig:
     # whatever grid the policy trained on
     grid: list[int] = field(default_factory=lambda: [4, 4])
     # shipped policies (assets/policies/<name>) evaluated with these settings beside a run in
-    # its report, marked "(reference)"; each evaluation is cached under runs_root/.reference
-    reference: list[str] = field(default_factory=lambda: ["blind_flat"])
+    # its report, marked "(reference: <name>)"; each evaluation is cached under
+    # runs_root/.reference. The flat walker and the reference set's blind policy (issue 28)
+    reference: list[str] = field(default_factory=lambda: ["blind_flat", "blind"])
     cells: list[EvalCell] = field(  # stairs = half the tiles up, half down
         default_factory=lambda: [
             EvalCell(t, d) for t in ("stairs", "uneven") for d in ("medium", "hard")

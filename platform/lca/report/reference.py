@@ -3,7 +3,9 @@ cells, seeds and sizes, so that a newcomer's first table has rows that walk besi
 
 Each evaluation is cached under `<runs_root>/.reference/<name>-<key>/`, the key a hash of the
 evaluation settings and the policy's checkpoint: every later run with the same settings
-reuses it. The cached run's rows read "<label> (reference)", never pooled with a new run's.
+reuses it. The cached run's rows read "<label> (reference: <name>)", never pooled with a new
+run's (two shipped policies of one label, e.g. the flat and the terrain blind walkers, stay two
+rows).
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from lca.evaluate.run import evaluate_and_write
 from lca.paths import assets_dir
 from lca.store import COMPLETE
 
-MARK = " (reference)"
+MARK = " (reference: {name})"
 # what a reference run carries over from the shipped one: no exports, clips or results
 KEEP = ("config.yaml", "provenance.json", "train_cfg.json", "train_curve.csv", COMPLETE)
 NO_MEDIA = {"videos": False, "reference": []}
@@ -46,16 +48,16 @@ def reference_run(name: str, eval_cfg: DictConfig, cache: Path, log=print) -> Pa
     cache.mkdir(parents=True, exist_ok=True)
     with _locked(cache / f"{name}.lock"):  # parallel sweep jobs evaluate it once
         if not (run / "summary.csv").is_file():
-            _copy(shipped, run, checkpoint, eval_cfg)
+            _copy(shipped, run, checkpoint, eval_cfg, name)
             log(f"[lca] reference {name}: evaluating on this run's cells (cached in {run})")
             evaluate_and_write(run, log=log)
     return run
 
 
-def _copy(shipped: Path, run: Path, checkpoint: Path, eval_cfg: DictConfig) -> None:
+def _copy(shipped: Path, run: Path, checkpoint: Path, eval_cfg: DictConfig, name: str) -> None:
     copy_run(shipped, run, checkpoint, eval=OmegaConf.merge(eval_cfg, NO_MEDIA))
     cfg = OmegaConf.load(run / "config.yaml")
-    cfg.policy.label = f"{cfg.policy.label}{MARK}"
+    cfg.policy.label = cfg.policy.label + MARK.format(name=name)
     OmegaConf.save(cfg, run / "config.yaml")
 
 

@@ -2,10 +2,11 @@
 
     python -m lca.report.results reports/reference
 
-prints two Markdown tables (success and contacts/step per cell, "ours (paper)") and the paired
-two-stage - one-stage differences with their CIs. The README carries that block verbatim
-between `<!-- results:begin -->` and `<!-- results:end -->`; tests/test_quoted_figures.py
-regenerates it from the files and compares, so a number in the README is always the file's.
+prints three Markdown tables (success, contacts per step and tracking error per cell, "ours
+(paper)") and the paired two-stage - one-stage differences with their CIs. The README
+carries that block verbatim between `<!-- results:begin -->` and `<!-- results:end -->`;
+tests/test_quoted_figures.py regenerates it from the files and compares, so a number in the
+README is always the file's.
 The paper's numbers are its simulation table (`assets/paper/sim_table.csv`).
 """
 
@@ -89,9 +90,13 @@ def results_block(report: Path) -> str:
         "",
         metric_table(ours, paper, "success"),
         "",
-        "Contacts/step (%), ours (paper):",
+        "Contacts per step, ours (paper):",
         "",
         metric_table(ours, paper, "contacts_per_step"),
+        "",
+        "Tracking error (cm/s), ours (paper); a robot standing still scores about 45:",
+        "",
+        metric_table(ours, paper, "track_cm_s"),
         "",
         "Two-stage − one-stage, paired over the same units (95 % bootstrap CI):",
         "",
