@@ -73,9 +73,9 @@ def evaluate_shipped(
     hardware: bool = True,
     threads: int = 0,
     log=print,
-) -> float:
+) -> None:
     """Evaluate one shipped policy into `out` (its tables' results, clips, hardware-style
-    tasks). `threads` > 0 pins torch and the physics to that many threads. Returns seconds."""
+    tasks). `threads` > 0 pins torch and the physics to that many threads."""
     t0 = time.perf_counter()
     if threads:
         set_torch_threads(threads)
@@ -83,9 +83,7 @@ def evaluate_shipped(
     evaluate_and_write(run, log=log)
     if hardware:
         run_hardware(run, load_run_config(run), log=log)
-    seconds = time.perf_counter() - t0
-    log(f"[lca] {policy}: evaluated in {seconds:.0f} s")
-    return seconds
+    log(f"[lca] {policy}: evaluated in {time.perf_counter() - t0:.0f} s")
 
 
 def training_table(runs: dict[str, Path]) -> pd.DataFrame:
