@@ -98,3 +98,14 @@ def test_evaluate_bench_times_one_and_two_policies_at_a_time() -> None:
     assert result["jobs1_s"] > 0 and result["jobs2_s"] > 0
     assert result["speedup"] == pytest.approx(result["jobs1_s"] / result["jobs2_s"])
     assert "2 at a time, 1 thread each" in evaluate.table(result)
+
+
+def test_hardware_bench_times_both_ground_representations_on_the_same_trials() -> None:
+    from lca.bench import hardware
+
+    small = ["hardware.trials=1", "hardware.time_limit_s=0.2", "hardware.tasks=[soft_ledge]"]
+    result = hardware.run(["shipped=one_mlp", *small], log=None)
+    row = result["tasks"]["soft_ledge"]
+    assert row["heightfield_s"] > 0 and row["strips_s"] > 0
+    assert result["speedup"] == pytest.approx(result["heightfield_s"] / result["strips_s"])
+    assert "| soft_ledge |" in hardware.table(result)

@@ -144,15 +144,73 @@ def test_stair_edges_are_skewed_25_degrees(cfg, built, name):
         )
 
 
-@pytest.mark.parametrize("name", ["stair_ascent", "stair_descent"])
-def test_mujoco_heightfield_is_the_task_terrain(built, name):
-    """What the robot and the cameras collide with is what the task layer queries."""
-    task, scene = built(name)
+ALL_TASKS = ["stair_ascent", "stair_descent", "hinged_ledge", "soft_ledge"]
+
+
+@functools.cache
+def built_as(representation: str, name: str):
+    return build_task(compose(["scale=smoke", f"hardware.representation={representation}"]), name)
+
+
+@pytest.mark.parametrize("representation", ["strips", "heightfield"])
+@pytest.mark.parametrize("name", ALL_TASKS)
+def test_mujoco_ground_is_the_task_terrain(representation, name):
+    """What the robot and the cameras collide with is what the task layer queries, in
+    either representation of the static ground (the task objects are not ground: the
+    points sample the ground before them and beside them)."""
+    task, scene = built_as(representation, name)
     rng = np.random.default_rng(5)
-    x, y = rng.uniform(0.5, 3.0, 150), rng.uniform(-1.0, 1.0, 150)
+    x, y = rng.uniform(-1.0, 3.0, 150), rng.uniform(-1.0, 1.0, 150)
+    if "ledge" in name:
+        x = np.where(np.abs(y) < 0.6, np.minimum(x, 0.9), x)  # off the plank and the mat
     np.testing.assert_allclose(
         ray_heights(scene.model, x, y), task.terrain.height_at(x, y), atol=1e-4
     )
+
+
+def slanted_rays(model: mujoco.MjModel, origins, vectors) -> np.ndarray:
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    geomid = np.zeros(1, np.int32)
+    return np.array(
+        [
+            mujoco.mj_ray(model, data, p, v, TERRAIN_ONLY, 1, -1, geomid)
+            for p, v in zip(origins, vectors, strict=True)
+        ]
+    )
+
+
+def marched(terrain, origins, vectors, step: float = 1e-4) -> np.ndarray:
+    """Distance along each ray to its first point at or below `terrain.height_at`."""
+    t = np.arange(0.0, 3.0, step)
+    out = []
+    for p, v in zip(origins, vectors, strict=True):
+        points = p + t[:, None] * v
+        below = points[:, 2] <= terrain.height_at(points[:, 0], points[:, 1])
+        out.append(t[np.argmax(below)])
+    return np.array(out)
+
+
+@pytest.mark.parametrize("name", ["stair_ascent", "hinged_ledge"])
+def test_strips_show_the_cameras_the_exact_ground(name):
+    """Camera-like rays (pitched 50-80 degrees down, any heading, from 1.2 m over the path)
+    hit the strips where they first meet the task's step function; the heightfield, whose
+    skewed risers are 1 cm ramps, agrees except for rays grazing a riser."""
+    rng = np.random.default_rng(7)
+    n = 300
+    origins = np.stack([rng.uniform(-0.5, 3.0, n), rng.uniform(-0.5, 0.5, n), np.full(n, 1.2)], 1)
+    pitch, heading = np.radians(rng.uniform(50, 80, n)), rng.uniform(-np.pi, np.pi, n)
+    vectors = np.stack(
+        [np.cos(pitch) * np.cos(heading), np.cos(pitch) * np.sin(heading), -np.sin(pitch)], 1
+    )
+    if name == "hinged_ledge":  # rays that reach the plank are the plank's, not the ground's
+        origins[:, 0] = np.minimum(origins[:, 0], 0.5)
+        vectors[:, 0] = -np.abs(vectors[:, 0])
+    task, scene = built_as("strips", name)
+    strips = slanted_rays(scene.model, origins, vectors)
+    np.testing.assert_allclose(strips, marched(task.terrain, origins, vectors), atol=2e-4)
+    field = slanted_rays(built_as("heightfield", name)[1].model, origins, vectors)
+    assert np.mean(np.abs(strips - field) < 0.02) >= 0.95
 
 
 # ---- ledges -----------------------------------------------------------------------------

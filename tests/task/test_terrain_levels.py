@@ -168,3 +168,18 @@ def test_when_the_curriculum_is_over_every_reset_goes_to_the_top_row(levelled):
 def test_levels_end_must_be_a_fraction():
     with pytest.raises(ValueError, match="terrain.levels_end"):
         compose([*LEVELLED, "terrain.levels_end=1.5"])
+
+
+def test_levels_from_zero_makes_row_zero_flat_and_rises_evenly_to_the_difficulty():
+    cfg = compose([*LEVELLED, "terrain.levels_from=0"])
+    terrain = generate(cfg.terrain, cfg.difficulty)
+    stairs = sorted((t for t in terrain.tiles if t.kind == "stairs_up"), key=lambda t: t.row)
+    risers = [t.params["riser"] for t in stairs]
+    assert risers[0] == 0.0
+    low, high = cfg.difficulty.stairs_riser
+    assert low <= risers[-1] <= high
+    # row r draws from [low, high] scaled by r / 3: each riser within its row's range
+    for row, riser in enumerate(risers):
+        assert low * row / 3 <= riser <= high * row / 3 + 1e-12, (row, risers)
+    with pytest.raises(ValueError, match="terrain.levels_from"):
+        compose([*LEVELLED, "terrain.levels_from=1.5"])

@@ -9,7 +9,18 @@ import sys
 
 from lca.paths import reports_dir
 
-BENCHMARKS = ("sim", "env", "train", "learn", "walk", "levers", "clips", "report", "evaluate")
+BENCHMARKS = (
+    "sim",
+    "env",
+    "train",
+    "learn",
+    "walk",
+    "levers",
+    "clips",
+    "report",
+    "evaluate",
+    "hardware",
+)
 
 
 def result_name(name: str, result: dict) -> str:

@@ -133,6 +133,9 @@ class TerrainConfig:
     # half their commanded distance, and past the top row restart on a random one
     levels: bool = False
     max_init_level: int = 0  # envs start on rows 0..this (IsaacLab: 5 of 10)
+    # fraction of the difficulty's riser and block heights on row 0, rising evenly to 1 on
+    # the top row (None: 1 / rows, rows of equal steps); 0 makes row 0 flat ground
+    levels_from: float | None = None
     # fraction of the run from which the curriculum is over: every env resets onto the top
     # row, the configured difficulty itself (1.0: never, IsaacLab's way)
     levels_end: float = 1.0
@@ -174,6 +177,11 @@ class TerrainConfig:
             0 <= self.max_init_level < self.rows,
             "terrain.max_init_level",
             f"must be in [0, rows - 1 = {self.rows - 1}], got {self.max_init_level}",
+        )
+        require(
+            self.levels_from is None or 0 <= self.levels_from <= 1,
+            "terrain.levels_from",
+            f"must be a fraction of the difficulty in [0, 1] or null, got {self.levels_from}",
         )
         require(
             0 <= self.levels_end <= 1,
@@ -249,6 +257,9 @@ class HingedPlankConfig:
     damping: float = 2.0  # N m s / rad
     # m between the ledge wall and the plank's near end, so a tipping plank clears it
     gap: float = 0.05
+    # solver line-search iterations of this scene at least: at training's 5 (sim.ls_iterations)
+    # a 20 kg load landing on the plank pushed it 12 degrees through the floor in one step
+    ls_iterations: int = 20
 
 
 @dataclass
@@ -276,7 +287,10 @@ class HardwareConfig:
     approach: float = 1.0  # m of flat ground (or platform) before the feature
     goal_past: float = 0.6  # m past the feature's end that counts as completed
     ledge_drop: float = 0.36  # m, elevation change of both ledges (paper)
-    resolution: float = 0.01  # m, heightfield of the static geometry
+    resolution: float = 0.01  # m, samples of the static geometry (previews, heightfield)
+    # strips: the static geometry as rotated boxes, exact risers (the depth cameras' rays
+    # cost microseconds); heightfield: its 1 cm samples (rays far slower: lca.bench hardware)
+    representation: str = "strips"
     stairs: StairTaskConfig = field(default_factory=StairTaskConfig)
     plank: HingedPlankConfig = field(default_factory=HingedPlankConfig)
     mat: SoftMatConfig = field(default_factory=SoftMatConfig)
@@ -289,3 +303,9 @@ class HardwareConfig:
                 f"unknown '{task}'; allowed: {HARDWARE_TASKS}",
             )
         require(self.trials >= 1, "hardware.trials", "must be >= 1")
+        allowed = ("strips", "heightfield")
+        require(
+            self.representation in allowed,
+            "hardware.representation",
+            f"unknown '{self.representation}'; allowed: {allowed}",
+        )

@@ -1,7 +1,8 @@
 """The paper's four hardware tasks as simulation scenes, all dimensions from `conf/hardware`.
 
 The robot starts at the origin facing +x. Static geometry (ground, steps, ledge platforms) is
-a heightfield, so the task layer's exact height queries still hold; the hinged plank and the
+rotated boxes (`lca.sim.strips`, or a heightfield: `hardware.representation`), with exact
+height queries for the task layer either way; the hinged plank and the
 soft mat are the project's own MJCF (assets/hardware/*.xml) attached on top of it, resized
 from the config. `python -m lca.hardware.scenes` writes each whole scene as a binary model.
 """
@@ -18,6 +19,7 @@ from omegaconf import DictConfig
 from lca.paths import assets_dir
 from lca.sim.config import HardwareConfig
 from lca.sim.scene import Scene, build_scene
+from lca.sim.strips import Strips
 from lca.sim.terrain import Terrain, Tile
 
 ASSETS = assets_dir() / "hardware"
@@ -39,32 +41,31 @@ def _grid(res: float) -> tuple[np.ndarray, np.ndarray]:
     return np.meshgrid(xs, ys)  # (rows=y, cols=x)
 
 
-def _terrain(name: str, heights: np.ndarray, res: float) -> Terrain:
-    return Terrain(heights, res, (EXTENT_X[0], EXTENT_Y[0]), [Tile(name, 0, 0, (0.0, 0.0))])
-
-
-def stair_distance(x: np.ndarray, y: np.ndarray, skew_deg: float) -> np.ndarray:
-    """Distance along the flight's climbing direction, rotated `skew_deg` from +x."""
-    s = np.radians(skew_deg)
-    return x * np.cos(s) + y * np.sin(s)
+def _terrain(name: str, cfg: HardwareConfig, ground: Strips) -> Terrain:
+    """The task's ground: `ground` as rotated boxes (`hardware.representation=strips`), or
+    its 1 cm samples as a heightfield; the samples draw previews either way."""
+    x, y = _grid(cfg.resolution)
+    heights = np.asarray(ground.height_at(x, y), dtype=float)
+    strips = ground if cfg.representation == "strips" else None
+    tiles = [Tile(name, 0, 0, (0.0, 0.0))]
+    return Terrain(heights, cfg.resolution, (EXTENT_X[0], EXTENT_Y[0]), tiles, strips=strips)
 
 
 def stairs(cfg: HardwareConfig, up: bool) -> HardwareTask:
     st = cfg.stairs
-    x, y = _grid(cfg.resolution)
-    along = stair_distance(x, y, st.skew_deg) - cfg.approach
-    # Points exactly on an edge belong to the step beyond it.
-    level = np.clip(np.floor(along / st.landing + 1e-9) + 1, 0, st.steps)
-    heights = st.riser * (level if up else st.steps - level)
+    # the first riser `approach` along the climbing direction, then one per landing
+    edges = cfg.approach + st.landing * np.arange(st.steps)
+    levels = np.arange(st.steps + 1) if up else st.steps - np.arange(st.steps + 1)
+    ground = Strips(float(np.radians(st.skew_deg)), edges, st.riser * levels)
     end_along = cfg.approach + st.steps * st.landing
     goal = end_along / np.cos(np.radians(st.skew_deg)) + cfg.goal_past
     name = "stair_ascent" if up else "stair_descent"
-    return HardwareTask(name, _terrain(name, heights, cfg.resolution), goal)
+    return HardwareTask(name, _terrain(name, cfg, ground), goal)
 
 
-def _platform(cfg: HardwareConfig, top: float) -> np.ndarray:
-    x, _ = _grid(cfg.resolution)
-    return np.where(x < cfg.approach, top, 0.0)
+def _platform(top: float, cfg: HardwareConfig) -> Strips:
+    """A platform `top` high up to x = approach, the ground at 0 beyond."""
+    return Strips(0.0, np.array([cfg.approach]), np.array([top, 0.0]))
 
 
 def _attach(spec: mujoco.MjSpec, asset: str, pos: list[float]) -> mujoco.MjSpec:
@@ -80,7 +81,7 @@ def hinged_ledge(cfg: HardwareConfig) -> HardwareTask:
     """A platform `ledge_drop` above a plank that pivots about its centre."""
     p = cfg.plank
     plank_top = p.pivot_height + p.thickness / 2
-    heights = _platform(cfg, plank_top + cfg.ledge_drop)
+    ground = _platform(plank_top + cfg.ledge_drop, cfg)
     centre_x = cfg.approach + p.gap + p.length / 2
     support_half = (p.pivot_height - p.thickness / 2 - 0.01) / 2
 
@@ -96,17 +97,16 @@ def hinged_ledge(cfg: HardwareConfig) -> HardwareTask:
         plank = spec.geom("plank")
         plank.size = [p.length / 2, p.width / 2, p.thickness / 2]
         plank.mass = p.mass
+        spec.option.ls_iterations = max(spec.option.ls_iterations, p.ls_iterations)
 
     goal = cfg.approach + p.gap + p.length + cfg.goal_past
-    return HardwareTask(
-        "hinged_ledge", _terrain("hinged_ledge", heights, cfg.resolution), goal, decorate
-    )
+    return HardwareTask("hinged_ledge", _terrain("hinged_ledge", cfg, ground), goal, decorate)
 
 
 def soft_ledge(cfg: HardwareConfig) -> HardwareTask:
     """A platform `ledge_drop` above a compliant mat lying on the ground."""
     m = cfg.mat
-    heights = _platform(cfg, m.thickness + cfg.ledge_drop)
+    ground = _platform(m.thickness + cfg.ledge_drop, cfg)
 
     def decorate(spec: mujoco.MjSpec) -> None:
         _attach(spec, "soft_mat", [cfg.approach + m.length / 2, 0.0, 0.0])
@@ -117,9 +117,7 @@ def soft_ledge(cfg: HardwareConfig) -> HardwareTask:
         mat.solimp = list(m.solimp)
 
     goal = cfg.approach + m.length + cfg.goal_past
-    return HardwareTask(
-        "soft_ledge", _terrain("soft_ledge", heights, cfg.resolution), goal, decorate
-    )
+    return HardwareTask("soft_ledge", _terrain("soft_ledge", cfg, ground), goal, decorate)
 
 
 TASKS = {

@@ -14,9 +14,8 @@ import mujoco
 import numpy as np
 
 from lca.arrays import Array, arrays, device_of, namespace
+from lca.sim.strips import BASE_DEPTH
 from lca.sim.terrain import Terrain, Tile
-
-BASE_DEPTH = 0.5  # m of solid below the lowest terrain point (as under the heightfield)
 
 
 @dataclass

@@ -13,6 +13,7 @@ from omegaconf import DictConfig
 from lca.sim import robot as g1
 from lca.sim.config import RobotConfig, SimConfig
 from lca.sim.relief import BASE_DEPTH, add_boxes
+from lca.sim.strips import add_strips
 from lca.sim.terrain import Terrain, generate
 
 INTEGRATORS = {
@@ -62,6 +63,12 @@ def add_terrain(
         )
         return
     (x0, y0), (sx, sy) = terrain.origin, terrain.size
+    if terrain.strips is not None:
+        corners = np.array([[x0, y0], [x0 + sx, y0], [x0, y0 + sy], [x0 + sx, y0 + sy]])
+        add_strips(spec, terrain.strips, corners, rgba, collide)
+        if apron > 0:
+            _add_apron(spec, (x0, y0), (sx, sy), apron, rgba, collide)
+        return
     if terrain.representation == "boxes":
         add_boxes(spec, terrain, rgba, collide)
         # the border (inside the sample grid) joins the apron: flat ground around the tiles

@@ -24,6 +24,7 @@ import numpy as np
 from lca.arrays import Array, arrays, device_of, like, namespace
 from lca.config.registry import TILES
 from lca.sim.config import DifficultyConfig, TerrainConfig
+from lca.sim.strips import Strips
 
 
 @dataclass
@@ -51,6 +52,9 @@ class Terrain:
     # (each tile's cells as boxes; tiles without cells stay a heightfield of their own)
     representation: str = "heightfield"
     tile_size: float = 0.0
+    # a hardware task's ground as steps along one direction (rotated boxes): when set, the
+    # physics and `height_at` use it, and `heights` only draws previews
+    strips: Strips | None = None
     _flat: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     @property
@@ -70,6 +74,8 @@ class Terrain:
     def height_at(self, x: Array, y: Array) -> Array:
         """Surface height at world points, exactly as the physics sees it: the boxes' tops
         (a point on a vertical edge takes the cell on its +x / +y side), or the heightfield."""
+        if self.strips is not None:
+            return self.strips.height_at(x, y)
         if self.representation != "boxes":
             return self.field_height_at(x, y)
         from lca.sim.relief import cell_height_at
@@ -206,10 +212,14 @@ def uneven_tile(lx, ly, cfg: TerrainConfig, difficulty: DifficultyConfig, rng) -
     return _blocks(lx, ly, cfg, low, high, rng), {"low": low, "high": high}
 
 
-def level_difficulty(difficulty: DifficultyConfig, level: int, levels: int) -> DifficultyConfig:
-    """Row `level` of a levelled grid: riser and block heights at (level + 1) / levels of
-    the difficulty's, so the last row is the difficulty itself (treads stay)."""
-    scale = (level + 1) / levels
+def level_difficulty(
+    difficulty: DifficultyConfig, level: int, levels: int, start: float | None = None
+) -> DifficultyConfig:
+    """Row `level` of a levelled grid: riser and block heights at a fraction of the
+    difficulty's rising evenly from `start` on row 0 (None: 1 / levels) to 1 on the last
+    row, so the last row is the difficulty itself (treads stay)."""
+    start = 1 / levels if start is None else start
+    scale = 1.0 if levels == 1 else start + (1 - start) * level / (levels - 1)
     out = copy.deepcopy(difficulty)
     out.stairs_riser = [scale * h for h in difficulty.stairs_riser]
     out.uneven_height = [scale * h for h in difficulty.uneven_height]
@@ -240,7 +250,11 @@ def generate(cfg: TerrainConfig, difficulty: DifficultyConfig, seed: int | None 
     for index, kind in enumerate(grid_kinds(cfg, rng)):
         row, col = divmod(index, cfg.cols)
         centre = ((col + 0.5) * cfg.tile_size, (row + 0.5) * cfg.tile_size)
-        level = level_difficulty(difficulty, row, cfg.rows) if cfg.levels else difficulty
+        level = (
+            level_difficulty(difficulty, row, cfg.rows, cfg.levels_from)
+            if cfg.levels
+            else difficulty
+        )
         h, params, cells = _tile(kind, lx, ly, cfg, level, rng)
         r0, c0 = border_n + row * tile_n, border_n + col * tile_n
         heights[r0 : r0 + tile_n, c0 : c0 + tile_n] = h
