@@ -55,8 +55,13 @@ def test_evaluate_only_reports_two_shipped_policies(tmp_path):
     shutil.copytree(BLIND_FLAT, shipped / "blind")
     _ship(shipped, "two_mlp")
     spec = OmegaConf.to_container(OmegaConf.load(REFERENCE))
-    spec |= {"shipped": str(shipped), "report": str(tmp_path / "report"), "hardware": False}
+    spec |= {"shipped": str(shipped), "report": str(tmp_path / "report"), "hardware": True}
     spec["overrides"] = ["scale=smoke", "eval.units=4", "eval.steps=30"]
+    spec["overrides"] += [
+        "hardware.trials=2",
+        "hardware.time_limit_s=0.2",
+        "hardware.tasks=[soft_ledge]",
+    ]
     file = tmp_path / "reference.yaml"
     OmegaConf.save(OmegaConf.create(spec), file)
 
@@ -81,6 +86,15 @@ def test_evaluate_only_reports_two_shipped_policies(tmp_path):
     assert (tmp_path / "runs" / "evaluated" / "blind" / "summary.csv").is_file()
     evaluated = OmegaConf.load(tmp_path / "runs" / "evaluated" / "two_mlp" / "config.yaml")
     assert evaluated.sim.num_threads == 1
+    # the hardware-style tasks ran beside the cells, in copies of their own, then joined
+    for policy in ("blind", "two_mlp"):
+        trials = pd.read_csv(tmp_path / "runs" / "evaluated" / policy / "hardware.csv")
+        assert list(trials["task"]) == ["soft_ledge"] * 2
+    assert sorted(p.name for p in (tmp_path / "runs" / "evaluated").iterdir()) == [
+        "blind",
+        "two_mlp",
+    ]
+    assert set(pd.read_csv(report / "hardware_table.csv")["policy"]) >= {"Blind", "Two-Stage MLP"}
 
 
 def test_a_shipped_policy_is_not_trained_again(tmp_path, capsys):

@@ -9,16 +9,18 @@ seeds and sizes for every policy), evaluated (tables' results, clips), run throu
 hardware-style tasks, and the report is built into the file's `report` folder together with
 `training.csv`: each policy's environment steps and wall-clock, as its run recorded them.
 
-With `jobs` > 1 (`--jobs`, or the file's `evaluate_jobs`) that many policies are evaluated at
-once, each in a process of its own with one torch and one physics thread: on 2 cores two such
-processes outrun one with two threads, because each one's Python work (observations, rewards,
-inference) runs while the other steps its physics (reports/benchmarks.md).
+With `jobs` > 1 (`--jobs`, or the file's `evaluate_jobs`) the policies' parts (each one's
+cells, each one's hardware-style tasks) are evaluated that many at once, each in a process of
+its own with one torch and one physics thread: on 2 cores two such processes outrun one with
+two threads, because each one's Python work (observations, rewards, inference) runs while the
+other steps its physics (reports/benchmarks.md).
 """
 
 from __future__ import annotations
 
 import json
 import multiprocessing
+import shutil
 import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
@@ -86,6 +88,30 @@ def evaluate_shipped(
     log(f"[lca] {policy}: evaluated in {time.perf_counter() - t0:.0f} s")
 
 
+def evaluate_part(
+    part: str, policy: str, shipped: Path, out: Path, overrides: list[str], threads: int, log=print
+) -> None:
+    """One part of a shipped policy's evaluation into its own copy `out`: `cells` (the
+    tables' results and clips) or `hardware` (the hardware-style tasks)."""
+    t0 = time.perf_counter()
+    set_torch_threads(threads)
+    run = evaluated_copy(policy, shipped, out, overrides, threads)
+    if part == "cells":
+        evaluate_and_write(run, log=log)
+    else:
+        run_hardware(run, load_run_config(run), log=log)
+    log(f"[lca] {policy}: {part} evaluated in {time.perf_counter() - t0:.0f} s")
+
+
+def join_hardware(source: Path, run: Path) -> None:
+    """Move the hardware-style tasks' files from their copy `source` into `run`."""
+    (source / "hardware.csv").replace(run / "hardware.csv")
+    for clip in sorted((source / "clips").glob("hw_*")):
+        (run / "clips").mkdir(exist_ok=True)
+        clip.replace(run / "clips" / clip.name)
+    shutil.rmtree(source)
+
+
 def training_table(runs: dict[str, Path]) -> pd.DataFrame:
     """One row per policy: the environment steps and wall-clock of its run (its curve's last
     row), and where it started (a warm start's checkpoint, from its config)."""
@@ -140,16 +166,7 @@ def evaluate_only(
         for policy, folder in found.items():
             evaluate_shipped(policy, folder, runs[policy], overrides, hardware, log=log)
     else:
-        log(f"[lca] --evaluate-only: {len(found)} policies, {jobs} at a time, 1 thread each")
-        # spawn: a fork of a process that already ran torch's thread pool can deadlock
-        context = multiprocessing.get_context("spawn")
-        with ProcessPoolExecutor(jobs, mp_context=context) as pool:
-            futures = [
-                pool.submit(evaluate_shipped, p, f, runs[p], overrides, hardware, 1)
-                for p, f in found.items()
-            ]
-            for future in futures:
-                future.result()  # a policy's failure fails the command
+        _evaluate_in_parallel(found, runs, overrides, hardware, jobs, log)
     report = root() / spec.get("report", f"reports/{spec['name']}")
     index = build_report(list(runs.values()), report)
     training_table(runs).to_csv(report / "training.csv", index=False)
@@ -160,3 +177,27 @@ def evaluate_only(
     )
     log(f"[lca] report: {index} ({len(runs)} policies, {seconds / 60:.1f} min)")
     return 0
+
+
+def _evaluate_in_parallel(found, runs, overrides, hardware: bool, jobs: int, log) -> None:
+    """Every policy's cells, then every policy's hardware-style tasks, as a queue of parts
+    for `jobs` processes of one thread each: the longest parts first, so that no core idles
+    while one policy's whole evaluation finishes alone. A hardware part runs in a copy of
+    its own (a run directory is one process's at a time); its files then join the run's."""
+    log(f"[lca] --evaluate-only: {len(found)} policies, {jobs} processes of 1 thread each")
+    aside = {p: runs[p].parent / ".hardware" / p for p in found}
+    parts = [("cells", p, runs[p]) for p in found]
+    parts += [("hardware", p, aside[p]) for p in found] if hardware else []
+    # spawn: a fork of a process that already ran torch's thread pool can deadlock
+    context = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(jobs, mp_context=context) as pool:
+        futures = [
+            pool.submit(evaluate_part, part, p, found[p], out, overrides, 1)
+            for part, p, out in parts
+        ]
+        for future in futures:
+            future.result()  # a part's failure fails the command
+    if hardware:
+        for p in found:
+            join_hardware(aside[p], runs[p])
+        shutil.rmtree(next(iter(aside.values())).parent)
