@@ -19,6 +19,7 @@ from pathlib import Path
 
 from omegaconf import OmegaConf
 
+from lca.bench.timing import split_params
 from lca.paths import assets_dir, root
 from lca.shipped import evaluate_only
 
@@ -26,13 +27,7 @@ DEFAULTS = {"shipped": "blind,blind", "jobs": "2", "hardware": "false"}
 
 
 def run(overrides: list[str], log: Callable[[str], None] | None = print) -> dict:
-    params, extra = dict(DEFAULTS), []
-    for item in overrides:
-        key, _, value = item.partition("=")
-        if key in DEFAULTS:
-            params[key] = value
-        else:
-            extra.append(item)
+    params, extra = split_params(overrides, DEFAULTS)
     reference = OmegaConf.to_container(OmegaConf.load(root() / "experiments" / "reference.yaml"))
     sources = params["shipped"].split(",")
     names = reference["policies"][: len(sources)]

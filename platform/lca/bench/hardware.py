@@ -18,6 +18,7 @@ from pathlib import Path
 
 import torch
 
+from lca.bench.timing import split_params
 from lca.config import set_torch_threads
 from lca.evaluate.hardware import run_hardware
 from lca.evaluate.policy import load_run_config
@@ -28,13 +29,7 @@ REPRESENTATIONS = ("heightfield", "strips")  # baseline first
 
 
 def run(overrides: list[str], log: Callable[[str], None] | None = print) -> dict:
-    params, extra = dict(DEFAULTS), []
-    for item in overrides:
-        key, _, value = item.partition("=")
-        if key in DEFAULTS:
-            params[key] = value
-        else:
-            extra.append(item)
+    params, extra = split_params(overrides, DEFAULTS)
     quiet = (lambda _: None) if log is None else log
     result: dict = {"shipped": params["shipped"], "overrides": extra, "tasks": {}}
     with tempfile.TemporaryDirectory() as tmp:

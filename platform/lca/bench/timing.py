@@ -21,3 +21,16 @@ def rate(step: Callable[[], int], min_seconds: float, min_calls: int = 3) -> flo
 def median_rate(step: Callable[[], int], repeats: int, min_seconds: float) -> float:
     rates = sorted(rate(step, min_seconds) for _ in range(repeats))
     return rates[len(rates) // 2]
+
+
+def split_params(overrides: list[str], defaults: dict[str, str]) -> tuple[dict, list[str]]:
+    """The benchmark's own `key=value` parameters (those in `defaults`, which fill the
+    missing ones) and the rest of `overrides` (Hydra overrides), in order."""
+    params, extra = dict(defaults), []
+    for item in overrides:
+        key, _, value = item.partition("=")
+        if key in defaults:
+            params[key] = value
+        else:
+            extra.append(item)
+    return params, extra
