@@ -24,6 +24,7 @@ from lca.evaluate.protocol import (
     round_seed,
     run_round,
 )
+from lca.evaluate.rollout import step_only
 from lca.evaluate.run import evaluate_and_write
 from lca.sim.terrain import generate
 from lca.task.env import LocomotionEnv
@@ -183,8 +184,8 @@ class FoldLegs:
 
 
 def test_run_round_stops_counting_at_first_termination() -> None:
-    """Units that fall: success 0, their steps are those before the fall (not the whole round,
-    though the env resets and keeps stepping them), and the per-step metrics are over those
+    """Units that fall: success 0, their steps are those before the fall (not the whole round;
+    the env resets them and they stand frozen), and the per-step metrics are over those
     steps only: the same numbers as stepping the env by hand."""
     steps = 150
     cfg = smoke_cfg(f"eval.steps={steps}")
@@ -210,11 +211,30 @@ def test_run_round_stops_counting_at_first_termination() -> None:
         first_end[alive & (m["terminated"] | m["time_out"])] = t + 1
         if (first_end > 0).all():
             break
+        step_only(env, first_end < 0)
     np.testing.assert_array_equal(out["steps"], first_end)
     np.testing.assert_allclose(out["contacts_per_step"], 100 * impacts / first_end)
     np.testing.assert_allclose(out["track_cm_s"], 100 * track / first_end)
     np.testing.assert_array_equal(out["command_x"], command_x)
     assert ((command_x >= 0.3) & (command_x <= 0.6)).all()
+
+
+def test_units_that_no_longer_count_cost_no_physics() -> None:
+    """`step_only`: the physics steps the units still counted; the others stand frozen."""
+    cfg = smoke_cfg()
+    env = LocomotionEnv(cell_config(cfg, _cell(cfg, "stairs", "medium")))
+    actor = FoldLegs(env)
+    env.reseed(5)
+    env.reset_all()
+    counted = np.arange(env.num_envs) % 2 == 0
+    step_only(env, counted)
+    before = np.array(env.sim.qpos, copy=True)
+    for _ in range(3):
+        env.step(actor(None))
+    moved = np.any(np.asarray(env.sim.qpos) != before, axis=1)
+    np.testing.assert_array_equal(moved, counted)
+    env.reset_all()  # a new round steps every unit again
+    assert env.stepping is None
 
 
 # ---- a real evaluation -------------------------------------------------------------------

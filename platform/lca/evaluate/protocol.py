@@ -24,7 +24,7 @@ from lca.arrays import to_numpy
 from lca.config import load_option
 from lca.evaluate.metrics import episode_metrics
 from lca.evaluate.policy import final_checkpoint, load_policy, sees_map
-from lca.evaluate.rollout import rollout, start
+from lca.evaluate.rollout import rollout, start, step_only
 from lca.evaluate.terrains import eval_mixture
 from lca.store import atomic_write
 from lca.task.env import LocomotionEnv
@@ -93,6 +93,7 @@ def run_round(env: LocomotionEnv, policy, steps: int) -> dict[str, np.ndarray]:
         alive &= ~(m["terminated"] | m["time_out"])
         if not alive.any():
             break
+        step_only(env, alive)
     out = episode_metrics(alive_steps, impacts, track, success)
     out["command_x"] = command_x
     return out

@@ -6,6 +6,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Iterator
 
+import numpy as np
 import torch
 from tensordict import TensorDict
 
@@ -20,6 +21,16 @@ def start(env: LocomotionEnv, policy) -> TensorDict:
     obs = env.reset_all()
     policy.reset(torch.ones(env.num_envs, dtype=torch.bool, device=env.device))
     return obs
+
+
+def step_only(env: LocomotionEnv, units: np.ndarray) -> None:
+    """From the next step on, the physics steps only the units where `units` (bool, one per
+    unit) holds; the others stand frozen. A test stops counting a unit at its first
+    termination, and simulating it further was most of a failing policy's cost. Their
+    observations and rewards are still computed (vectorised, cheap) and ignored. A backend
+    that steps every world at once (warp) keeps stepping them all."""
+    if env.sim.steps_subsets:
+        env.stepping = np.flatnonzero(units)
 
 
 def rollout(

@@ -73,6 +73,8 @@ def host_layout(sim, scene: Scene, num_envs: int, seed: int) -> None:
 class BatchedSim:
     """Live (N, ...) views: `qpos`, `qvel`, `ctrl`, `sensordata`, and `sensor(name)`."""
 
+    steps_subsets = True  # `step(ids=...)` steps only those worlds
+
     def __init__(self, scene: Scene, num_envs: int, num_threads: int = 0, seed: int = 0):
         self.scene = scene
         self.model = scene.model

@@ -58,6 +58,8 @@ def buffer_sizes(model: mujoco.MjModel) -> tuple[int, int]:
 class WarpSim:
     """Live (N, ...) arrays `qpos`, `qvel`, `ctrl`, `sensordata`, and `sensor(name)`."""
 
+    steps_subsets = False  # every world steps at once
+
     def __init__(
         self,
         scene: Scene,

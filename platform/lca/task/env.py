@@ -98,6 +98,9 @@ class LocomotionEnv(VecEnv):
         self.perception = bool(task.perception)
         # evaluation turns it off: only the actor's observations (no critic map, no history)
         self.observe_critic = True
+        # the worlds the physics steps (None: all): a test freezes the units it no longer
+        # counts, so they cost no physics (`lca.evaluate.rollout.step_only`)
+        self.stepping: np.ndarray | None = None
         self.height_noise = float(cfg.difficulty.height_noise) if task.observations.noise else 0.0
 
         obs = task.observations
@@ -162,7 +165,7 @@ class LocomotionEnv(VecEnv):
         warnings_before = self._bad_state_warnings()
         self.contacts.clear()
         for _ in range(self.decimation):
-            self.sim.step()
+            self.sim.step(ids=self.stepping)
             self.contacts.update()
         self._episode_steps += 1
         if self.terrain_levels is not None:
@@ -410,7 +413,8 @@ class LocomotionEnv(VecEnv):
         self.sim.rng = generator(seed + 1, self._ref)
 
     def reset_all(self) -> TensorDict:
-        """Reset every environment and return fresh observations."""
+        """Reset every environment (each steps again) and return fresh observations."""
+        self.stepping = None
         self._reset_envs(self._all_ids())
         self.contacts.clear()
         self.history.buffer[:] = 0.0
