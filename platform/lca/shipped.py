@@ -67,32 +67,12 @@ def evaluated_copy(
     return out
 
 
-def evaluate_shipped(
-    policy: str,
-    shipped: Path,
-    out: Path,
-    overrides: list[str],
-    hardware: bool = True,
-    threads: int = 0,
-    log=print,
-) -> None:
-    """Evaluate one shipped policy into `out` (its tables' results, clips, hardware-style
-    tasks). `threads` > 0 pins torch and the physics to that many threads."""
-    t0 = time.perf_counter()
-    if threads:
-        set_torch_threads(threads)
-    run = evaluated_copy(policy, shipped, out, overrides, threads)
-    evaluate_and_write(run, log=log)
-    if hardware:
-        run_hardware(run, load_run_config(run), log=log)
-    log(f"[lca] {policy}: evaluated in {time.perf_counter() - t0:.0f} s")
-
-
 def evaluate_part(
     part: str, policy: str, shipped: Path, out: Path, overrides: list[str], threads: int, log=print
 ) -> None:
     """One part of a shipped policy's evaluation into its own copy `out`: `cells` (the
-    tables' results and clips) or `hardware` (the hardware-style tasks)."""
+    tables' results and clips) or `hardware` (the hardware-style tasks). `threads` > 0 pins
+    torch and the physics to that many threads."""
     t0 = time.perf_counter()
     set_torch_threads(threads)
     run = evaluated_copy(policy, shipped, out, overrides, threads)
@@ -106,8 +86,10 @@ def evaluate_part(
 def join_hardware(source: Path, run: Path) -> None:
     """Move the hardware-style tasks' files from their copy `source` into `run`."""
     (source / "hardware.csv").replace(run / "hardware.csv")
-    for clip in sorted((source / "clips").glob("hw_*")):
+    clips = sorted((source / "clips").glob("hw_*"))
+    if clips:
         (run / "clips").mkdir(exist_ok=True)
+    for clip in clips:
         clip.replace(run / "clips" / clip.name)
     shutil.rmtree(source)
 
@@ -162,11 +144,7 @@ def evaluate_only(
     t0 = time.perf_counter()
     runs = {p: runs_root / "evaluated" / p for p in found}
     hardware = bool(spec.get("hardware", True))
-    if jobs == 1:
-        for policy, folder in found.items():
-            evaluate_shipped(policy, folder, runs[policy], overrides, hardware, log=log)
-    else:
-        _evaluate_in_parallel(found, runs, overrides, hardware, jobs, log)
+    _evaluate_parts(found, runs, overrides, hardware, jobs, log)
     report = root() / spec.get("report", f"reports/{spec['name']}")
     index = build_report(list(runs.values()), report)
     training_table(runs).to_csv(report / "training.csv", index=False)
@@ -179,25 +157,31 @@ def evaluate_only(
     return 0
 
 
-def _evaluate_in_parallel(found, runs, overrides, hardware: bool, jobs: int, log) -> None:
-    """Every policy's cells, then every policy's hardware-style tasks, as a queue of parts
-    for `jobs` processes of one thread each: the longest parts first, so that no core idles
-    while one policy's whole evaluation finishes alone. A hardware part runs in a copy of
-    its own (a run directory is one process's at a time); its files then join the run's."""
-    log(f"[lca] --evaluate-only: {len(found)} policies, {jobs} processes of 1 thread each")
-    aside = {p: runs[p].parent / ".hardware" / p for p in found}
+def _evaluate_parts(found, runs, overrides, hardware: bool, jobs: int, log) -> None:
+    """Every policy's cells, then every policy's hardware-style tasks, as one queue of parts:
+    in this process (`jobs` 1), or for `jobs` processes of one thread each, the longest parts
+    first, so that no core idles while one policy's whole evaluation finishes alone. A
+    hardware part runs in a copy of its own (a run directory is one process's at a time);
+    its files then join the run's."""
+    aside_root = next(iter(runs.values())).parent / ".hardware"
+    aside = {p: aside_root / p for p in found}
     parts = [("cells", p, runs[p]) for p in found]
     parts += [("hardware", p, aside[p]) for p in found] if hardware else []
-    # spawn: a fork of a process that already ran torch's thread pool can deadlock
-    context = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(jobs, mp_context=context) as pool:
-        futures = [
-            pool.submit(evaluate_part, part, p, found[p], out, overrides, 1)
-            for part, p, out in parts
-        ]
-        for future in futures:
-            future.result()  # a part's failure fails the command
+    if jobs == 1:
+        for part, p, out in parts:
+            evaluate_part(part, p, found[p], out, overrides, 0, log)
+    else:
+        log(f"[lca] --evaluate-only: {len(found)} policies, {jobs} processes of 1 thread each")
+        # spawn: a fork of a process that already ran torch's thread pool can deadlock
+        context = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(jobs, mp_context=context) as pool:
+            futures = [
+                pool.submit(evaluate_part, part, p, found[p], out, overrides, 1)
+                for part, p, out in parts
+            ]
+            for future in futures:
+                future.result()  # a part's failure fails the command
     if hardware:
         for p in found:
             join_hardware(aside[p], runs[p])
-        shutil.rmtree(next(iter(aside.values())).parent)
+        shutil.rmtree(aside_root)
