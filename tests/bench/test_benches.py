@@ -95,9 +95,19 @@ def test_evaluate_bench_times_one_and_two_policies_at_a_time() -> None:
     small.append("eval.cells=[{terrain: flat, difficulty: medium}]")
     result = evaluate.run(["shipped=blind_flat,blind_flat", *small], log=None)
     assert list(result["policies"]) == ["blind", "one_mlp"]  # the reference file's names
-    assert result["jobs1_s"] > 0 and result["jobs2_s"] > 0
-    assert result["speedup"] == pytest.approx(result["jobs1_s"] / result["jobs2_s"])
+    assert result["baseline_s"] > 0 and result["current_s"] > 0
+    assert result["speedup"] == pytest.approx(result["baseline_s"] / result["current_s"])
     assert "2 at a time, 1 thread each" in evaluate.table(result)
+    assert result["arms"]["baseline"] == {"jobs": 1, "overrides": []}
+
+    against = evaluate.run(
+        ["shipped=blind_flat", "jobs=1", "baseline=eval.grid=[1,1]", *small], log=None
+    )
+    assert against["arms"] == {
+        "baseline": {"jobs": 1, "overrides": ["eval.grid=[1,1]"]},
+        "current": {"jobs": 1, "overrides": []},
+    }
+    assert "with eval.grid=[1,1] (1 at a time)" in evaluate.table(against)
 
 
 def test_hardware_bench_times_both_ground_representations_on_the_same_trials() -> None:
@@ -109,3 +119,18 @@ def test_hardware_bench_times_both_ground_representations_on_the_same_trials() -
     assert row["heightfield_s"] > 0 and row["strips_s"] > 0
     assert result["speedup"] == pytest.approx(result["heightfield_s"] / result["strips_s"])
     assert "| soft_ledge |" in hardware.table(result)
+
+
+def test_clips_bench_films_one_recording_with_both_grounds() -> None:
+    from lca.bench import clips
+    from lca.sim.render import gl_unavailable
+
+    if gl_unavailable():
+        pytest.skip(f"MuJoCo cannot render here: {gl_unavailable()}")
+    one = ["eval.cells=[{terrain: uneven, difficulty: medium}]", "eval.video_seconds=0.2"]
+    result = clips.run([*one, "frames=3"], log=None)
+    assert result["clips"] == 1
+    ((cell, costs),) = result["frames"].items()
+    assert cell == "uneven-medium" and costs["crop_ms"] > 0 and costs["window_ms"] > 0
+    assert result["frame_speedup"] == pytest.approx(costs["crop_ms"] / costs["window_ms"])
+    assert "| uneven-medium |" in clips.table(result)

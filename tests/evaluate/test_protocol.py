@@ -120,6 +120,23 @@ def test_cell_config(cfg, terrain: str, difficulty: str) -> None:
     assert commands.resample_time_s > c.task.episode_length_s  # one command per episode
 
 
+def test_each_round_draws_its_own_terrain(cfg) -> None:
+    """A cell's rounds meet different tiles, drawn from the eval seed alone: the same for
+    every policy, whatever seed it trained with."""
+    cell = _cell(cfg, "stairs", "hard")
+    risers = [
+        [t.params["riser"] for t in generate(c.terrain, c.difficulty).tiles]
+        for c in (cell_config(cfg, cell, episode) for episode in (0, 1))
+    ]
+    assert risers[0] != risers[1]
+    other = cfg.copy()
+    other.seed, other.terrain.seed = 7, 99
+    again = cell_config(other, cell, 1)
+    assert [t.params["riser"] for t in generate(again.terrain, again.difficulty).tiles] == (
+        risers[1]
+    )
+
+
 def test_cell_config_leaves_the_run_config_alone(cfg) -> None:
     before = OmegaConf.to_yaml(cfg)
     cell_config(cfg, _cell(cfg, "uneven", "hard"))

@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 from _cli import run_module
 
-from lca.sim import render
+from lca.sim import relief, render
+from lca.sim.terrain import Terrain
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -43,6 +44,48 @@ def test_crop_keeps_world_positions(mixed_scene) -> None:
     assert window.tiles[0].centre == (x, y)  # the scene's home stays on the first tile
     away = render.crop(terrain, (1e3, 1e3), (1e3 + 1, 1e3 + 1))  # off the grid: still a field
     assert min(away.heights.shape) >= 2
+
+
+def test_window_keeps_the_boxes_it_meets(mixed_cfg, mixed_scene) -> None:
+    """A boxes terrain's render window: its boxes that meet the window, as the physics has
+    them; a hardware ground's strips whole."""
+    terrain = mixed_scene.terrain
+    assert terrain.representation == "boxes"
+    x, y = terrain.tiles[0].centre
+    lo, hi = (x - 1.5, y - 2.0), (x + 2.5, y + 1.0)
+    near = render.window(terrain, lo, hi)
+    assert near.window == (lo, hi) and terrain.window is None  # the physics' terrain untouched
+    every, kept = relief.terrain_boxes(terrain), relief.terrain_boxes(near)
+    assert 0 < len(kept) < len(every) / 2
+    for box in every:
+        meets = box.x[1] >= lo[0] and box.x[0] <= hi[0] and box.y[1] >= lo[1] and box.y[0] <= hi[1]
+        assert (box in kept) == meets
+    model = render.render_scene(mixed_cfg, near).model
+    names = [model.geom(i).name for i in range(model.ngeom)]
+    assert sum(n.startswith("terrain_box") for n in names) == len(kept)
+    strips = Terrain(terrain.heights, terrain.resolution, terrain.origin, terrain.tiles)
+    strips.strips = object()  # only its presence matters here
+    assert render.window(strips, lo, hi) is strips
+
+
+def test_supersampled_frame_is_the_block_mean(flat_cfg, flat_scene) -> None:
+    """A frame drawn at twice the size comes back as the rounded means of its 2 x 2 blocks."""
+    needs_gl()
+    x, y = flat_scene.terrain.tiles[0].centre
+    scene = render.render_scene(
+        flat_cfg, render.crop(flat_scene.terrain, (x - 3, y - 3), (x + 3, y + 3))
+    )
+    small = render.TrackingCamera(scene.model)
+    big = render.TrackingCamera(scene.model, 2 * render.WIDTH, 2 * render.HEIGHT, supersample=1)
+    try:
+        frame, raw = small.frame(scene.home_qpos, 0.4), big.frame(scene.home_qpos, 0.4)
+    finally:
+        small.close()
+        big.close()
+    h, w = frame.shape[:2]
+    mean = raw.reshape(h, 2, w, 2, 3).mean(axis=(1, 3))
+    assert np.abs(frame - mean).max() <= 0.5 + 1e-9
+    assert frame.std() > 10
 
 
 def test_simplified_meshes_stay_in_place(flat_cfg, flat_scene) -> None:

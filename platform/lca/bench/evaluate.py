@@ -4,6 +4,10 @@ against `jobs` policies at a time with one thread each, timed in the same run:
     python -m lca.bench evaluate [shipped=blind,blind] [jobs=2] [hardware=false] \
         [eval.steps=300 eval.videos=false ...]
 
+or, with `baseline=` (overrides joined by `;`), the same `jobs` both times, the first with
+those overrides added: what a setting costs against the reference file's, e.g.
+`baseline='eval.grid=[4,4]'`.
+
 `shipped` names folders under assets/policies/; each is evaluated under the next policy name
 of experiments/reference.yaml (the same folder twice measures two equal policies). The rest
 are overrides of the experiment (`--evaluate-only`'s), e.g. a shorter episode.
@@ -23,7 +27,7 @@ from lca.bench.timing import split_params
 from lca.paths import assets_dir, root
 from lca.shipped import evaluate_only
 
-DEFAULTS = {"shipped": "blind,blind", "jobs": "2", "hardware": "false"}
+DEFAULTS = {"shipped": "blind,blind", "jobs": "2", "hardware": "false", "baseline": ""}
 
 
 def run(overrides: list[str], log: Callable[[str], None] | None = print) -> dict:
@@ -47,23 +51,40 @@ def run(overrides: list[str], log: Callable[[str], None] | None = print) -> dict
             "hardware": params["hardware"] == "true",
             "overrides": [*reference["overrides"], *extra],
         }
-        for jobs in (1, int(params["jobs"])):
-            quiet(f"[bench] {len(names)} policies, {jobs} at a time")
+        for arm, (jobs, added) in _arms(params).items():
+            quiet(f"[bench] {arm}: {len(names)} policies, {jobs} at a time {' '.join(added)}")
             t0 = time.perf_counter()
-            evaluate_only(spec, spec["overrides"], Path(tmp, f"runs{jobs}"), log=quiet, jobs=jobs)
-            result[f"jobs{jobs}_s"] = time.perf_counter() - t0
+            overrides = [*spec["overrides"], *added]
+            evaluate_only(spec, overrides, Path(tmp, f"runs_{arm}"), log=quiet, jobs=jobs)
+            result[f"{arm}_s"] = time.perf_counter() - t0
+            result.setdefault("arms", {})[arm] = {"jobs": jobs, "overrides": added}
     result["jobs"] = int(params["jobs"])
-    result["speedup"] = result["jobs1_s"] / result[f"jobs{result['jobs']}_s"]
+    result["baseline"] = params["baseline"]
+    result["speedup"] = result["baseline_s"] / result["current_s"]
     return result
+
+
+def _arms(params: dict) -> dict[str, tuple[int, list[str]]]:
+    """What is timed: the baseline first, then the reference file's setting."""
+    jobs = int(params["jobs"])
+    if params["baseline"]:
+        return {"baseline": (jobs, params["baseline"].split(";")), "current": (jobs, [])}
+    return {"baseline": (1, []), "current": (jobs, [])}
 
 
 def table(result: dict) -> str:
     jobs = result["jobs"]
+    if result["baseline"]:
+        first = f"  with {result['baseline']} ({jobs} at a time):"
+        second = f"  as the reference file sets it ({jobs} at a time):"
+    else:
+        first = "  1 at a time, 2 threads:"
+        second = f"  {jobs} at a time, 1 thread each:"
+    width = max(len(first), len(second))
     return "\n".join(
         [
             f"evaluate-only of {list(result['policies'].values())} {' '.join(result['overrides'])}",
-            f"  1 at a time, 2 threads:      {result['jobs1_s']:7.1f} s",
-            f"  {jobs} at a time, 1 thread each: {result[f'jobs{jobs}_s']:7.1f} s "
-            f"({result['speedup']:.2f}x)",
+            f"{first:<{width}} {result['baseline_s']:7.1f} s",
+            f"{second:<{width}} {result['current_s']:7.1f} s ({result['speedup']:.2f}x)",
         ]
     )

@@ -121,11 +121,14 @@ def film(
     rec: Recording,
     label: str,
     decorate: render.Decorate | None = None,
+    ground: Callable[..., Terrain] = render.window,
 ) -> list[np.ndarray]:
-    """The frames of `rec` from a camera tracking the robot, with the velocity overlay."""
+    """The frames of `rec` from a camera tracking the robot, with the velocity overlay.
+    `ground(terrain, lo, hi)`: what the render model draws of the terrain around the path
+    (`render.crop` draws its samples, as clips did before `render.window`)."""
     path = np.array([q[:2] for q in rec.qpos])
-    window = render.crop(terrain, path.min(0) - MARGIN, path.max(0) + MARGIN)
-    camera = render.TrackingCamera(render.render_scene(cfg, window, decorate).model)
+    near = ground(terrain, path.min(0) - MARGIN, path.max(0) + MARGIN)
+    camera = render.TrackingCamera(render.render_scene(cfg, near, decorate).model)
     frames, heading = [], 0.0
     try:
         for i, (qpos, now) in enumerate(zip(rec.qpos, rec.telemetry, strict=True)):

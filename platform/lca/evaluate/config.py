@@ -38,8 +38,8 @@ class EvalConfig:
     units: int = 32  # simulated robots per cell (paper: 500)
     episodes: int = 2  # episodes per unit (paper: 3)
     steps: int = 500  # policy steps per episode (paper: 1000)
-    # rows x cols tiles of each cell's terrain: 16 draws of riser or block field per cell,
-    # whatever grid the policy trained on
+    # rows x cols tiles of each round's terrain (every cell and episode round draws its own):
+    # 16 draws of riser or block field per round, whatever grid the policy trained on
     grid: list[int] = field(default_factory=lambda: [4, 4])
     # shipped policies (assets/policies/<name>) evaluated with these settings beside a run in
     # its report, marked "(reference: <name>)"; each evaluation is cached under

@@ -62,14 +62,18 @@ def trial_config(
     return c
 
 
-def cell_config(cfg: DictConfig, cell) -> DictConfig:
-    """The run's config turned into the evaluation setting of one cell."""
+def cell_config(cfg: DictConfig, cell, episode: int = 0) -> DictConfig:
+    """The run's config turned into the evaluation setting of one cell's round `episode`.
+    Each round draws its own `eval.grid` of tiles from the round's seed, so a cell meets
+    rounds x tiles terrain draws while each model holds only one round's boxes (a box costs
+    every unit physics time wherever it is: reports/benchmarks.md)."""
     ev = cfg.eval
     episode_s = ev.steps * cfg.sim.timestep * cfg.sim.decimation
     c = trial_config(cfg, ev.units, episode_s, ev.command_x)
     c.terrain.mixture = eval_mixture(cell.terrain)
     c.terrain.rows, c.terrain.cols = ev.grid
     c.terrain.name = cell.terrain
+    c.terrain.seed = round_seed(ev.seed, cell, episode)
     c.difficulty = difficulty_config(cell.difficulty)
     return c
 
@@ -113,11 +117,11 @@ def evaluate_run(run_dir: Path, cfg: DictConfig, log=print) -> pd.DataFrame:
         todo = [e for e in range(ev.episodes) if not (out_dir / name / f"episode_{e}.csv").exists()]
         if not todo:
             continue
-        env = LocomotionEnv(cell_config(cfg, cell))
-        env.set_perception(perception)
-        policy = load_policy(cfg, env, checkpoint)
         for episode in todo:
             t0 = time.perf_counter()
+            env = LocomotionEnv(cell_config(cfg, cell, episode))
+            env.set_perception(perception)
+            policy = load_policy(cfg, env, checkpoint)
             env.reseed(round_seed(ev.seed, cell, episode))
             result = run_round(env, policy, ev.steps)
             frame = pd.DataFrame(result)
@@ -136,6 +140,9 @@ def evaluate_run(run_dir: Path, cfg: DictConfig, log=print) -> pd.DataFrame:
 
 
 NOT_PROTOCOL = ("videos", "video_seconds")  # eval keys that do not change the results
+# bump when the protocol's code changes its results, so that older rounds are run again
+# (2: each round draws its own terrain)
+PROTOCOL_VERSION = 2
 
 
 def _discard_stale_rounds(out_dir: Path, ev, log) -> None:
@@ -143,6 +150,7 @@ def _discard_stale_rounds(out_dir: Path, ev, log) -> None:
     protocol = OmegaConf.to_container(ev, resolve=True)
     for key in NOT_PROTOCOL:
         protocol.pop(key, None)
+    protocol["protocol_version"] = PROTOCOL_VERSION
     settings = json.dumps(protocol, sort_keys=True)
     stamp = out_dir / "protocol.json"
     if out_dir.exists() and (not stamp.exists() or stamp.read_text() != settings):

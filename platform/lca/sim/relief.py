@@ -58,7 +58,12 @@ def tile_boxes(tile: Tile) -> list[Box]:
 
 
 def terrain_boxes(terrain: Terrain) -> list[Box]:
-    return [box for tile in terrain.tiles if tile.cells is not None for box in tile_boxes(tile)]
+    """Every tile's boxes; those that meet `terrain.window` where it is set."""
+    boxes = [box for tile in terrain.tiles if tile.cells is not None for box in tile_boxes(tile)]
+    if terrain.window is None:
+        return boxes
+    (x0, y0), (x1, y1) = terrain.window
+    return [b for b in boxes if b.x[1] >= x0 and b.x[0] <= x1 and b.y[1] >= y0 and b.y[0] <= y1]
 
 
 def base_height(terrain: Terrain) -> float:

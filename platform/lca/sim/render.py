@@ -11,6 +11,7 @@ filmed, at `RENDER_RESOLUTION`, with a checkered ground, a sky and a sun (no sha
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 import os
@@ -88,6 +89,23 @@ def crop(
         t for t in terrain.tiles if x0 <= t.centre[0] <= x0 + sx and y0 <= t.centre[1] <= y0 + sy
     ] or [Tile("window", 0, 0, box.centre)]
     return box
+
+
+def window(
+    terrain: Terrain,
+    lo: tuple[float, float],
+    hi: tuple[float, float],
+    resolution: float = RENDER_RESOLUTION,
+) -> Terrain:
+    """What a render model draws of `terrain` around the world box [lo, hi]: a boxes
+    terrain's boxes that meet it, a hardware task's strips whole (a few dozen geoms, exact
+    edges: software OpenGL draws them 2-3x faster than a heightfield's triangles), otherwise
+    the `crop` of its samples."""
+    if terrain.strips is not None:
+        return terrain
+    if terrain.representation == "boxes":
+        return dataclasses.replace(terrain, window=(tuple(lo), tuple(hi)))
+    return crop(terrain, lo, hi, resolution)
 
 
 def simplify_mesh(vert: np.ndarray, face: np.ndarray, cell: float) -> tuple:
@@ -173,7 +191,7 @@ def _dress(spec: mujoco.MjSpec) -> None:
     )
     ground.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = "lca_checker"
     for geom in spec.geoms:
-        if geom.name == "terrain" or geom.name.startswith("apron"):
+        if geom.name.startswith(("terrain", "apron")):  # a field, boxes, strips, the floor
             geom.material = "lca_ground"
             geom.rgba = [1.0, 1.0, 1.0, 1.0]
     spec.worldbody.add_light(
@@ -241,8 +259,12 @@ class Camera:
         k = self.supersample
         if k == 1:
             return image
-        (h, w), c = self.size, image.shape[2:]
-        return image.reshape(h, k, w, k, *c).mean(axis=(1, 3)).round().astype(image.dtype)
+        # the k x k block means in integers: 10x faster than a float mean over a reshape
+        total = np.zeros((*self.size, image.shape[2]), np.uint32)
+        for i in range(k):
+            for j in range(k):
+                total += image[i::k, j::k]
+        return ((total + k * k // 2) // (k * k)).astype(image.dtype)
 
     def close(self) -> None:
         self.renderer.close()

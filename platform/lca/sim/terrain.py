@@ -55,6 +55,9 @@ class Terrain:
     # a hardware task's ground as steps along one direction (rotated boxes): when set, the
     # physics and `height_at` use it, and `heights` only draws previews
     strips: Strips | None = None
+    # render models only: the world box (lo, hi) outside which the boxes representation
+    # leaves its boxes out (`lca.sim.render.window`); the physics always has all of them
+    window: tuple[tuple[float, float], tuple[float, float]] | None = None
     _flat: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     @property
