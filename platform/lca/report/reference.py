@@ -20,6 +20,7 @@ from pathlib import Path
 from omegaconf import DictConfig, OmegaConf
 
 from lca.evaluate.policy import final_checkpoint
+from lca.evaluate.protocol import PROTOCOL_VERSION
 from lca.evaluate.run import evaluate_and_write
 from lca.paths import assets_dir
 from lca.store import COMPLETE
@@ -41,6 +42,7 @@ def reference_run(name: str, eval_cfg: DictConfig, cache: Path, log=print) -> Pa
     shipped = assets_dir() / "policies" / name  # eval.reference is checked at composition
     settings = OmegaConf.to_container(eval_cfg, resolve=True)
     settings = {k: v for k, v in settings.items() if k not in ("videos", "reference")}
+    settings["protocol_version"] = PROTOCOL_VERSION  # a newer protocol evaluates afresh
     checkpoint = final_checkpoint(shipped)
     digest = hashlib.sha256(json.dumps(settings, sort_keys=True).encode())
     digest.update(checkpoint.read_bytes())
