@@ -91,12 +91,7 @@ def crop(
     return box
 
 
-def window(
-    terrain: Terrain,
-    lo: tuple[float, float],
-    hi: tuple[float, float],
-    resolution: float = RENDER_RESOLUTION,
-) -> Terrain:
+def window(terrain: Terrain, lo: tuple[float, float], hi: tuple[float, float]) -> Terrain:
     """What a render model draws of `terrain` around the world box [lo, hi]: a boxes
     terrain's boxes that meet it, a hardware task's strips whole (a few dozen geoms, exact
     edges: software OpenGL draws them 2-3x faster than a heightfield's triangles), otherwise
@@ -105,7 +100,7 @@ def window(
         return terrain
     if terrain.representation == "boxes":
         return dataclasses.replace(terrain, window=(tuple(lo), tuple(hi)))
-    return crop(terrain, lo, hi, resolution)
+    return crop(terrain, lo, hi)
 
 
 def simplify_mesh(vert: np.ndarray, face: np.ndarray, cell: float) -> tuple:
