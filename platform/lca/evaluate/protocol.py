@@ -117,11 +117,14 @@ def evaluate_run(run_dir: Path, cfg: DictConfig, log=print) -> pd.DataFrame:
         todo = [e for e in range(ev.episodes) if not (out_dir / name / f"episode_{e}.csv").exists()]
         if not todo:
             continue
+        policy = None
         for episode in todo:
             t0 = time.perf_counter()
             env = LocomotionEnv(cell_config(cfg, cell, episode))
             env.set_perception(perception)
-            policy = load_policy(cfg, env, checkpoint)
+            # the rounds' envs differ in terrain only: one actor serves them all
+            if policy is None:
+                policy = load_policy(cfg, env, checkpoint)
             env.reseed(round_seed(ev.seed, cell, episode))
             result = run_round(env, policy, ev.steps)
             frame = pd.DataFrame(result)
