@@ -86,7 +86,7 @@ def flat_env() -> LocomotionEnv:
 def test_cameras_cover_the_grid_on_a_flat_floor(flat_env: LocomotionEnv):
     """The zero map below is not zero for lack of points: the cameras fill the grid."""
     env = flat_env
-    points, valid = env.cameras.capture()
+    points, valid = env.camera_map.cameras.capture()
     assert valid.mean() > 0.9
     np.testing.assert_allclose(points[valid][:, 2], 0.0, atol=0.05)
     state = env._state
@@ -190,6 +190,6 @@ def test_camera_frames_follow_floor_t_times_30_over_a_long_episode():
         steps = env.episode_length_buf.numpy()
         assert (steps == steps[0]).all()
         expected = steps * 30 // 50  # floor(t * 30) with t = steps / 50, exactly
-        if not np.array_equal(env._camera_frame, expected):
+        if not np.array_equal(env.camera_map.frame, expected):
             late.append(int(steps[0]))
     assert late == []

@@ -20,11 +20,11 @@ from lca.arrays import Array, as_float, draw, generator, like, namespace, zeros
 from lca.config.registry import REWARD_TERMS
 from lca.config.runtime import resolve_device
 from lca.sim.backend import make_sim
-from lca.sim.depth_camera import CameraSpec, DepthCameras
 from lca.sim.scene import Scene, build_scene
-from lca.task import heightmap, observations, perception
+from lca.task import heightmap, observations
 from lca.task.actions import action_scales, joint_ids
 from lca.task.commands import VelocityCommand, gait_phase
+from lca.task.deployment_map import DeploymentMap
 from lca.task.rewards import RewardContext, compute_rewards, weights_and_params
 from lca.task.state import (
     ContactAccumulator,
@@ -118,12 +118,9 @@ class LocomotionEnv(VecEnv):
 
         self.commands = VelocityCommand(task.commands, self.num_envs, self.dt, self.rng, ref)
         self.perception_cfg = OmegaConf.to_object(cfg.perception)
-        self.cameras = None
+        self.camera_map = None
         if self.perception_cfg.source == "deployment":
-            specs = [CameraSpec(**vars(c)) for c in self.perception_cfg.cameras]
-            self.cameras = DepthCameras(self.sim, specs, self.rng)
-            self._camera_frame = np.full(self.num_envs, -1)
-            self._deployment_map = np.zeros((self.num_envs, self.actor_offsets.shape[0]))
+            self.camera_map = DeploymentMap(self.sim, self.perception_cfg, obs, self.rng)
         self.contacts = ContactAccumulator(self.sim)
         self.warnings = self.sim.warnings
         self.episode_length_buf = torch.zeros(self.num_envs, dtype=torch.long, device=self.device)
@@ -272,8 +269,8 @@ class LocomotionEnv(VecEnv):
             self.sim.set_friction_scale(ids, draw(self.rng, *rand.friction, n, self._ref))
         self.commands.resample(ids)
         self._episode_steps[ids] = 0
-        if self.cameras is not None:
-            self._camera_frame[ids] = -1
+        if self.camera_map is not None:
+            self.camera_map.restart(ids)
         self.action[ids] = 0.0
         self.last_action[ids] = 0.0
         for sums in self.episode_sums.values():
@@ -348,7 +345,7 @@ class LocomotionEnv(VecEnv):
         self._state = state
         yaw = yaw_of(state.base_quat)
         # the actor's points only when its map is read from the terrain (not blind, no cameras)
-        split = self.actor_offsets.shape[0] if self.perception and self.cameras is None else 0
+        split = self.actor_offsets.shape[0] if self.perception and self.camera_map is None else 0
         if self.observe_critic:
             offsets = self.map_offsets if split else self.critic_offsets
             raw = heightmap.sample_heights(self.scene.terrain, state.base_pos[:, :2], yaw, offsets)
@@ -376,29 +373,6 @@ class LocomotionEnv(VecEnv):
             device=self.device,
         )
 
-    def _camera_map(self, state: RobotState, yaw: np.ndarray) -> np.ndarray:
-        """The latest deployment map: cameras fire at `rate_hz`; between frames the policy
-        reads the last map (a reset env gets a fresh frame at once)."""
-        # the epsilon keeps t = k / rate on frame k despite float rounding (205 * 0.02 * 30)
-        frame = np.floor(self._episode_steps * self.dt * self.perception_cfg.rate_hz + 1e-9)
-        due = frame != self._camera_frame
-        if due.any():
-            points, valid = self.cameras.capture()
-            obs = self.task_cfg.observations
-            fresh = perception.deployment_map(
-                points,
-                valid,
-                state.base_pos[:, :2],
-                yaw,
-                tuple(obs.actor_grid),
-                obs.actor_spacing,
-                self.perception_cfg.outlier_gamma,
-                self.perception_cfg.quantum,
-            )
-            self._deployment_map[due] = fresh[due]
-            self._camera_frame = np.where(due, frame, self._camera_frame)
-        return self._deployment_map.copy()
-
     @property
     def state(self) -> RobotState:
         """The state the latest observation was made from (reset envs: their new state)."""
@@ -408,8 +382,8 @@ class LocomotionEnv(VecEnv):
         """Restart every random stream (resets, noise, commands) from `seed`."""
         self.rng = generator(seed, self._ref)
         self.commands.rng = self.rng
-        if self.cameras is not None:
-            self.cameras.rng = self.rng
+        if self.camera_map is not None:
+            self.camera_map.rng = self.rng
         self.sim.rng = generator(seed + 1, self._ref)
 
     def reset_all(self) -> TensorDict:
@@ -448,8 +422,9 @@ class LocomotionEnv(VecEnv):
         """The actor's map; `raw`: the terrain heights under its grid, if already sampled."""
         if not self.perception:
             return self._zeros((self.num_envs, self.actor_offsets.shape[0]))
-        if self.cameras is not None:
-            return self._camera_map(state, yaw)
+        if self.camera_map is not None:
+            episode_s = self._episode_steps * self.dt
+            return self.camera_map.read(episode_s, state.base_pos[:, :2], yaw)
         if raw is None:
             raw = heightmap.sample_heights(
                 self.scene.terrain, state.base_pos[:, :2], yaw, self.actor_offsets

@@ -52,8 +52,8 @@ def env_state(env) -> dict:
             "level": copy_of(levels.level),
             "origin": copy_of(sim.env_origin),
         } | {name: copy_of(getattr(levels, name)) for name in LEVEL_TRACKS}
-    if env.cameras is not None:
-        state["camera"] = {"frame": env._camera_frame.copy(), "map": env._deployment_map.copy()}
+    if env.camera_map is not None:
+        state["camera"] = {"frame": env.camera_map.frame.copy(), "map": env.camera_map.map.copy()}
     return state
 
 
@@ -100,7 +100,7 @@ def restore_env_state(env, state: dict) -> None:
     set_rng_state(env.rng, state["rng"])
     set_rng_state(sim.rng, state["sim_rng"])
     if state["camera"] is not None:
-        env._camera_frame[:] = state["camera"]["frame"]
-        env._deployment_map[:] = state["camera"]["map"]
+        env.camera_map.frame[:] = state["camera"]["frame"]
+        env.camera_map.map[:] = state["camera"]["map"]
     env.episode_length_buf = torch.as_tensor(env._episode_steps, device=env.device)
     sim.forward()  # derived quantities (sensors, contacts) from the restored state
