@@ -3,7 +3,8 @@
     python -m lca.report.results reports/reference
 
 prints three Markdown tables (success, contacts per step and tracking error per cell, "ours
-(paper)") and the paired two-stage - one-stage differences with their CIs. The README
+(paper)") and a verdict on each of the paper's claims from the CIs: parity at medium
+difficulty, and the paired two-stage - one-stage differences. The README
 carries that block verbatim between `<!-- results:begin -->` and `<!-- results:end -->`;
 tests/test_quoted_figures.py regenerates it from the files and compares, so a number in the
 README is always the file's.
@@ -34,6 +35,7 @@ CLAIMS = [  # (terrain, difficulty, metric) the paper's claims rest on
     ("stairs", "medium", "contacts_per_step"),
     ("stairs", "hard", "contacts_per_step"),
 ]
+PAPER_GAIN = 10.0  # points: two-stage over one-stage on uneven hard, the paper's claim
 
 
 def paper_table() -> pd.DataFrame:
@@ -62,20 +64,67 @@ def metric_table(ours: pd.DataFrame, paper: pd.DataFrame, metric: str) -> str:
     return "\n".join(lines)
 
 
+def _claim_rows(claim: pd.DataFrame, terrain: str, difficulty: str, metric: str):
+    sel = (claim.terrain == terrain) & (claim.difficulty == difficulty) & (claim.metric == metric)
+    return claim[sel].itertuples(index=False)
+
+
+def _verdict(diff_low: float, diff_high: float, better: int) -> str:
+    """'seen' when the CI lies on the claimed side of zero (`better` = +1 or -1), 'reversed'
+    when it lies on the other side, else 'not decided (the CI spans 0)'."""
+    if better * diff_low > 0 and better * diff_high > 0:
+        return "seen"
+    if better * diff_low < 0 and better * diff_high < 0:
+        return "reversed"
+    return "not decided (the CI spans 0)"
+
+
+def _against_paper_gain(ci_low: float, ci_high: float) -> str:
+    if ci_low > PAPER_GAIN:
+        return f"larger than the paper's ~{PAPER_GAIN:g}"
+    if ci_high < PAPER_GAIN:
+        return f"smaller than the paper's ~{PAPER_GAIN:g}"
+    return f"the paper's ~{PAPER_GAIN:g} inside the CI"
+
+
 def claim_lines(claim: pd.DataFrame) -> str:
-    """One bullet per twin pair and claim cell: the paired difference and its 95 % CI."""
+    """One bullet per twin pair and claim cell: the paired difference, its 95 % CI and the
+    verdict on the paper's claim (two-stage succeeds more, by ~10 points on uneven hard, and
+    makes fewer contacts on stairs)."""
     lines = []
     for terrain, difficulty, metric in CLAIMS:
-        rows = claim[
-            (claim.terrain == terrain) & (claim.difficulty == difficulty) & (claim.metric == metric)
-        ]
-        unit = "points" if metric == "success" else "points of contacts/step"
-        for r in rows.itertuples(index=False):
+        success = metric == "success"
+        unit = "points" if success else "contacts/step"
+        for r in _claim_rows(claim, terrain, difficulty, metric):
+            verdict = _verdict(r.ci_low, r.ci_high, better=1 if success else -1)
+            if success and verdict == "seen":
+                verdict += ", " + _against_paper_gain(r.ci_low, r.ci_high)
             lines.append(
                 f"- {r.two_stage} − {r.one_stage}, {terrain} {difficulty}: "
-                f"{r.diff:+.1f} {unit} [{r.ci_low:+.1f}, {r.ci_high:+.1f}]"
+                f"{r.diff:+.{DIGITS[metric]}f} {unit} "
+                f"[{r.ci_low:+.{DIGITS[metric]}f}, {r.ci_high:+.{DIGITS[metric]}f}]: {verdict}"
             )
     return "\n".join(lines) or "- no two-stage policy has its one-stage twin in this report"
+
+
+def parity_lines(ours: pd.DataFrame) -> str:
+    """The paper's parity claim at medium difficulty, per terrain: the lowest and highest
+    success with their 95 % CIs; parity is seen when those two CIs overlap."""
+    lines = []
+    for terrain in ("stairs", "uneven"):
+        rows = ours[
+            (ours.terrain == terrain) & (ours.difficulty == "medium") & (ours.metric == "success")
+        ].sort_values("mean")
+        if len(rows) < 2:
+            continue
+        low, high = rows.iloc[0], rows.iloc[-1]
+        verdict = "seen (the CIs overlap)" if low.ci_high >= high.ci_low else "not seen"
+        lines.append(
+            f"- Parity, {terrain} medium: {low.policy} {low['mean']:.1f} % "
+            f"[{low.ci_low:.1f}, {low.ci_high:.1f}] to {high.policy} {high['mean']:.1f} % "
+            f"[{high.ci_low:.1f}, {high.ci_high:.1f}]: {verdict}"
+        )
+    return "\n".join(lines)
 
 
 def results_block(report: Path) -> str:
@@ -98,8 +147,10 @@ def results_block(report: Path) -> str:
         "",
         metric_table(ours, paper, "track_cm_s"),
         "",
-        "Two-stage − one-stage, paired over the same units (95 % bootstrap CI):",
+        "The paper's claims on these files (95 % bootstrap CIs; the differences paired over",
+        "the same units):",
         "",
+        parity_lines(ours),
         claim_lines(claim),
         END,
     ]
