@@ -37,6 +37,52 @@ def test_quoted_flat_cell_figures_match_the_shipped_summary(doc: str, policy: st
         assert float(track) == round(metrics["track_cm_s"], decimals), (doc, track)
 
 
+# reports/learning.md's table of the reference recipe: a row per shipped policy, one column
+# per cell in this order, each "success [CI] / tracking / contacts per step"
+LEARNING_ROWS = {
+    "**R1 (the default)**": "blind",
+    "R1, One-Stage MLP": "one_mlp",
+    "R1, Two-Stage MLP": "two_mlp",
+    "R1, One-Stage CNN": "one_cnn",
+    "R1, Two-Stage CNN": "two_cnn",
+}
+LEARNING_CELLS = [("flat", "medium"), ("stairs", "medium"), ("stairs", "hard")]
+LEARNING_CELLS += [("uneven", "medium"), ("uneven", "hard")]
+CELL_QUOTE = re.compile(r"(\d+(?:\.\d)?)(?: \[(\d+\.\d), (\d+\.\d)\])? / (\d+\.\d) / (\d+\.\d\d)")
+
+
+def learning_rows() -> dict[str, list[str]]:
+    rows = {}
+    for line in (root() / "reports" / "learning.md").read_text().splitlines():
+        cols = [c.strip() for c in line.strip().strip("|").split("|")]
+        for label, policy in LEARNING_ROWS.items():
+            if cols[0].startswith(label):
+                rows[policy] = cols[1 : 1 + len(LEARNING_CELLS)]
+    return rows
+
+
+def test_learning_md_quotes_each_shipped_reference_policys_summary() -> None:
+    rows = learning_rows()
+    assert {"blind", "one_mlp", "two_mlp"} <= rows.keys()
+    for policy, cols in rows.items():
+        summary = pd.read_csv(root() / "assets" / "policies" / policy / "summary.csv")
+        for (terrain, difficulty), text in zip(LEARNING_CELLS, cols, strict=True):
+            quote = CELL_QUOTE.fullmatch(text)
+            assert quote, (policy, terrain, difficulty, text)
+            cell = summary[
+                (summary.cell_terrain == terrain) & (summary.cell_difficulty == difficulty)
+            ]
+            m = cell.set_index("metric")
+            success, low, high, track, contacts = quote.groups()
+            where = (policy, terrain, difficulty)
+            assert float(success) == pytest.approx(m.loc["success", "mean"], abs=0.05), where
+            if low is not None:
+                assert float(low) == round(m.loc["success", "ci_low"], 1), where
+                assert float(high) == round(m.loc["success", "ci_high"], 1), where
+            assert float(track) == round(m.loc["track_cm_s", "mean"], 1), where
+            assert float(contacts) == round(m.loc["contacts_per_step", "mean"], 2), where
+
+
 def test_the_readme_results_are_the_reference_report_beside_the_paper() -> None:
     """The README's Results block is exactly what `python -m lca.report.results` writes from
     reports/reference/ and the paper's table: every number in it is a file's."""
