@@ -19,10 +19,15 @@ QUOTED = {
 }
 
 
-def flat_cell(policy: str) -> dict[str, float]:
+def shipped_cell(policy: str, terrain: str, difficulty: str) -> pd.DataFrame:
+    """A shipped policy's summary.csv rows of one cell, indexed by metric."""
     summary = pd.read_csv(root() / "assets" / "policies" / policy / "summary.csv")
-    flat = summary[(summary.cell_terrain == "flat") & (summary.cell_difficulty == "medium")]
-    return dict(zip(flat.metric, flat["mean"], strict=True))
+    cell = summary[(summary.cell_terrain == terrain) & (summary.cell_difficulty == difficulty)]
+    return cell.set_index("metric")
+
+
+def flat_cell(policy: str) -> dict[str, float]:
+    return shipped_cell(policy, "flat", "medium")["mean"].to_dict()
 
 
 @pytest.mark.parametrize(("doc", "policy"), sorted(QUOTED.items()))
@@ -65,14 +70,10 @@ def test_learning_md_quotes_each_shipped_reference_policys_summary() -> None:
     rows = learning_rows()
     assert {"blind", "one_mlp", "two_mlp"} <= rows.keys()
     for policy, cols in rows.items():
-        summary = pd.read_csv(root() / "assets" / "policies" / policy / "summary.csv")
         for (terrain, difficulty), text in zip(LEARNING_CELLS, cols, strict=True):
             quote = CELL_QUOTE.fullmatch(text)
             assert quote, (policy, terrain, difficulty, text)
-            cell = summary[
-                (summary.cell_terrain == terrain) & (summary.cell_difficulty == difficulty)
-            ]
-            m = cell.set_index("metric")
+            m = shipped_cell(policy, terrain, difficulty)
             success, low, high, track, contacts = quote.groups()
             where = (policy, terrain, difficulty)
             assert float(success) == pytest.approx(m.loc["success", "mean"], abs=0.05), where

@@ -64,9 +64,10 @@ def metric_table(ours: pd.DataFrame, paper: pd.DataFrame, metric: str) -> str:
     return "\n".join(lines)
 
 
-def _claim_rows(claim: pd.DataFrame, terrain: str, difficulty: str, metric: str):
-    sel = (claim.terrain == terrain) & (claim.difficulty == difficulty) & (claim.metric == metric)
-    return claim[sel].itertuples(index=False)
+def _cell(table: pd.DataFrame, terrain: str, difficulty: str, metric: str) -> pd.DataFrame:
+    """The rows of `table` (sim_table.csv or claim.csv) for one cell and metric."""
+    sel = (table.terrain == terrain) & (table.difficulty == difficulty) & (table.metric == metric)
+    return table[sel]
 
 
 def _verdict(diff_low: float, diff_high: float, better: int) -> str:
@@ -95,7 +96,7 @@ def claim_lines(claim: pd.DataFrame) -> str:
     for terrain, difficulty, metric in CLAIMS:
         success = metric == "success"
         unit = "points" if success else "contacts/step"
-        for r in _claim_rows(claim, terrain, difficulty, metric):
+        for r in _cell(claim, terrain, difficulty, metric).itertuples(index=False):
             verdict = _verdict(r.ci_low, r.ci_high, better=1 if success else -1)
             if success and verdict == "seen":
                 verdict += ", " + _against_paper_gain(r.ci_low, r.ci_high)
@@ -112,9 +113,7 @@ def parity_lines(ours: pd.DataFrame) -> str:
     success with their 95 % CIs; parity is seen when those two CIs overlap."""
     lines = []
     for terrain in ("stairs", "uneven"):
-        rows = ours[
-            (ours.terrain == terrain) & (ours.difficulty == "medium") & (ours.metric == "success")
-        ].sort_values("mean")
+        rows = _cell(ours, terrain, "medium", "success").sort_values("mean")
         if len(rows) < 2:
             continue
         low, high = rows.iloc[0], rows.iloc[-1]
