@@ -3,6 +3,7 @@ its summary.csv, to the digits quoted."""
 
 from __future__ import annotations
 
+import functools
 import re
 
 import pandas as pd
@@ -19,9 +20,14 @@ QUOTED = {
 }
 
 
+@functools.cache
+def shipped_summary(policy: str) -> pd.DataFrame:
+    return pd.read_csv(root() / "assets" / "policies" / policy / "summary.csv")
+
+
 def shipped_cell(policy: str, terrain: str, difficulty: str) -> pd.DataFrame:
     """A shipped policy's summary.csv rows of one cell, indexed by metric."""
-    summary = pd.read_csv(root() / "assets" / "policies" / policy / "summary.csv")
+    summary = shipped_summary(policy)
     cell = summary[(summary.cell_terrain == terrain) & (summary.cell_difficulty == difficulty)]
     return cell.set_index("metric")
 
