@@ -81,3 +81,32 @@ def test_a_run_on_terrain_is_probed_on_stairs_and_uneven(tmp_path):
     assert list(probes["iteration"]) == [1]
     for key in ("stairs_success", "uneven_success"):
         assert 0.0 <= probes[key].iloc[0] <= 100.0, probes.to_dict()
+
+
+def test_a_terrain_runs_figure_plots_its_stairs_and_uneven_probes(tmp_path, monkeypatch):
+    evals = pd.DataFrame(
+        {
+            "iteration": [9, 19],
+            "env_steps": [1e6, 2e6],
+            "train_wall_s": [60.0, 120.0],
+            "penalty_scale": [1.0, 1.0],
+            "paper_objective": [0, 1],
+            "success": [100.0, 100.0],
+            "track_cm_s": [30.0, 25.0],
+            "still_cm_s": [5.0, 5.0],
+            "stairs_success": [10.0, 20.0],
+            "uneven_success": [70.0, 60.0],
+        }
+    )
+    figures = []
+    monkeypatch.setattr(walk.plt, "close", figures.append)
+    walk.plot(evals, tmp_path / "walk.png")
+    success = figures[0].axes[0]
+    curves = {line.get_label(): list(line.get_ydata()) for line in success.get_lines()}
+    assert curves["stairs-medium"] == [10.0, 20.0]
+    assert curves["uneven-medium"] == [70.0, 60.0]
+    assert (tmp_path / "walk.png").stat().st_size > 0
+    flat = evals.drop(columns=["stairs_success", "uneven_success"])
+    figures.clear()
+    walk.plot(flat, tmp_path / "flat.png")
+    assert "stairs-medium" not in {line.get_label() for line in figures[0].axes[0].get_lines()}
