@@ -8,6 +8,7 @@ import pytest
 from _cli import SMOKE
 
 from lca.bench import walk
+from lca.bench.__main__ import result_name
 
 pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
 
@@ -38,6 +39,7 @@ def test_until_stops_a_probed_run_that_is_complete(tmp_path):
     assert (run / "COMPLETE").is_file() and (tmp_path / "walk.png").stat().st_size > 0
     assert (run / "exported" / "policy.onnx").is_file()
     assert out["env_steps"] == int(curve["env_steps"].iloc[-1])
+    assert result_name("walk", out) == "walk.json"  # the flat time-to-walk's file
 
 
 def test_walking_needs_the_paper_objective():
@@ -63,7 +65,7 @@ def test_walking_on_terrain_needs_stairs_and_uneven():
 
 
 def test_a_run_on_terrain_is_probed_on_stairs_and_uneven(tmp_path):
-    walk.run(
+    out = walk.run(
         [
             *SMOKE,
             "terrain=mixed",
@@ -81,6 +83,8 @@ def test_a_run_on_terrain_is_probed_on_stairs_and_uneven(tmp_path):
     assert list(probes["iteration"]) == [1]
     for key in ("stairs_success", "uneven_success"):
         assert 0.0 <= probes[key].iloc[0] <= 100.0, probes.to_dict()
+    # its own result file, so a terrain run does not overwrite the flat time-to-walk
+    assert result_name("walk", out) == "walk_terrain.json"
 
 
 def test_a_terrain_runs_figure_plots_its_stairs_and_uneven_probes(tmp_path, monkeypatch):

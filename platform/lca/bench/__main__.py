@@ -26,8 +26,10 @@ BENCHMARKS = (
 def result_name(name: str, result: dict) -> str:
     """`<name>.json`, or `<name>_warp.json` when the benchmark ran on the MuJoCo-Warp backend
     (its result says so): `python -m lca.experiment --dry-run` reads the rate of the backend
-    it plans for."""
-    return f"{name}_warp.json" if result.get("backend") == "warp" else f"{name}.json"
+    it plans for. A result may name its own variant (`variant`: the walk on terrain), so
+    that it does not overwrite the plain one."""
+    stem = f"{name}_{result['variant']}" if result.get("variant") else name
+    return f"{stem}_warp.json" if result.get("backend") == "warp" else f"{stem}.json"
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -13,8 +13,9 @@ counted. The policy *walks* at the first evaluation with success >= 90 %, tracki
 (the reward curriculum, if any, has finished). Trained on terrain, it is also probed on
 stairs and uneven terrain at medium difficulty and walks only with >= 80 % success on each.
 Reports time_to_walk_s,
-steps_to_walk, steps/s, writes the curve figure reports/bench/walk.png and the run directory
-(a complete run: config, provenance, curve, checkpoints, exported policy).
+steps_to_walk, steps/s, writes the curve figure reports/bench/walk.png (walk_terrain.png and
+walk_terrain.json on terrain, so the flat result stays) and the run directory (a complete run:
+config, provenance, curve, checkpoints, exported policy).
 """
 
 from __future__ import annotations
@@ -77,7 +78,7 @@ OPTIONS = {
     "run": "runs/bench_walk",
     "resume": "false",
     "stop": "true",
-    "figure": str(REPORTS / "bench" / "walk.png"),
+    "figure": "",  # default: reports/bench/walk.png, walk_terrain.png for a run on terrain
 }
 
 
@@ -199,9 +200,13 @@ def summarise(run: RunDir, overrides: list[str], opts: dict, walked: dict | None
     cfg = OmegaConf.load(run.path / "config.yaml")
     curve = pd.read_csv(run.curve)
     evals = pd.read_csv(run.path / "probe_evals.csv")
-    plot(evals, Path(opts["figure"]))
+    on_terrain = cfg.terrain.name != "flat"
+    variant = "terrain" if on_terrain else ""
+    default = REPORTS / "bench" / ("walk_terrain.png" if on_terrain else "walk.png")
+    plot(evals, Path(opts["figure"] or default))
     train_s = float(curve["wall_s"].iloc[-1])
     return {
+        "variant": variant,  # the result's file: walk.json, or walk_terrain.json on terrain
         "overrides": overrides,
         "walked": walked is not None,
         "time_to_walk_s": walked["train_wall_s"] if walked else None,
@@ -221,7 +226,7 @@ def summarise(run: RunDir, overrides: list[str], opts: dict, walked: dict | None
             "steps": int(cfg.eval.steps),
             "cell": "flat-medium",
             "terrain_cells": [f"{c.terrain}-{c.difficulty}" for c in TERRAIN_CELLS]
-            if cfg.terrain.name != "flat"
+            if on_terrain
             else [],
         },
         "evals": evals.to_dict(orient="records"),
