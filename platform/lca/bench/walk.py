@@ -243,11 +243,15 @@ def plot(evals: pd.DataFrame, out: Path) -> None:
         (axes[1], "track_cm_s", TRACK_MAX, "tracking error (cm/s)"),
     ):
         ax.plot(minutes, evals[col], marker="o", lw=1.5, label="forward 0.3-0.6 m/s")
-        terrain = [k for k in terrain_keys() if k in evals and evals[k].notna().any()]
-        if col == "success" and terrain:  # a run on terrain: its probes beside flat's
-            for key, marker in zip(terrain, "^v", strict=False):
-                name = f"{key.removesuffix('_success')}-medium"
-                ax.plot(minutes, evals[key], marker=marker, lw=1, label=name)
+        probed = [
+            (cell, key, marker)
+            for cell, key, marker in zip(TERRAIN_CELLS, terrain_keys(), "^v", strict=True)
+            if key in evals and evals[key].notna().any()
+        ]
+        if col == "success" and probed:  # a run on terrain: its probes beside flat's
+            for cell, key, marker in probed:
+                label = f"{cell.terrain}-{cell.difficulty}"
+                ax.plot(minutes, evals[key], marker=marker, lw=1, label=label)
             ax.axhline(TERRAIN_SUCCESS_MIN, color="grey", ls=":", lw=1)
             ax.legend(fontsize=8)
         if col == "track_cm_s" and "still_cm_s" in evals:
