@@ -243,17 +243,6 @@ def plot(evals: pd.DataFrame, out: Path) -> None:
         (axes[1], "track_cm_s", TRACK_MAX, "tracking error (cm/s)"),
     ):
         ax.plot(minutes, evals[col], marker="o", lw=1.5, label="forward 0.3-0.6 m/s")
-        probed = [
-            (cell, key, marker)
-            for cell, key, marker in zip(TERRAIN_CELLS, terrain_keys(), "^v", strict=True)
-            if key in evals and evals[key].notna().any()
-        ]
-        if col == "success" and probed:  # a run on terrain: its probes beside flat's
-            for cell, key, marker in probed:
-                label = f"{cell.terrain}-{cell.difficulty}"
-                ax.plot(minutes, evals[key], marker=marker, lw=1, label=label)
-            ax.axhline(TERRAIN_SUCCESS_MIN, color="grey", ls=":", lw=1)
-            ax.legend(fontsize=8)
         if col == "track_cm_s" and "still_cm_s" in evals:
             ax.plot(minutes, evals["still_cm_s"], marker="s", lw=1, label="zero command")
             ax.legend(fontsize=8)
@@ -273,6 +262,7 @@ def plot(evals: pd.DataFrame, out: Path) -> None:
         even = np.linspace(0, float(minutes.max()), 6)
         top.set_xticks(np.round(_interp(even, minutes, evals.env_steps / 1e6), 1))
         top.set_xlabel("environment steps (M)", fontsize=8)
+    _plot_terrain_probes(axes[0], evals, minutes)
     fig.suptitle(
         "Time to walk: blind MLP, scale=cpu (shaded: under the paper's objective)",
         fontsize=11,
@@ -280,6 +270,21 @@ def plot(evals: pd.DataFrame, out: Path) -> None:
     fig.tight_layout()
     fig.savefig(out, dpi=120)
     plt.close(fig)
+
+
+def _plot_terrain_probes(ax, evals: pd.DataFrame, minutes: pd.Series) -> None:
+    """A run on terrain: its stairs and uneven probes beside flat's success."""
+    probed = [
+        (cell, key, marker)
+        for cell, key, marker in zip(TERRAIN_CELLS, terrain_keys(), "^v", strict=True)
+        if key in evals and evals[key].notna().any()
+    ]
+    for cell, key, marker in probed:
+        label = f"{cell.terrain}-{cell.difficulty}"
+        ax.plot(minutes, evals[key], marker=marker, lw=1, label=label)
+    if probed:
+        ax.axhline(TERRAIN_SUCCESS_MIN, color="grey", ls=":", lw=1)
+        ax.legend(fontsize=8)
 
 
 def _mark_objective(ax, evals: pd.DataFrame, minutes: pd.Series) -> None:
