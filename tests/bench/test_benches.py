@@ -110,6 +110,29 @@ def test_evaluate_bench_times_one_and_two_policies_at_a_time() -> None:
     assert "with eval.grid=[1,1] (1 at a time)" in evaluate.table(against)
 
 
+def test_floor_bench_scales_each_part_to_the_shipped_evaluation() -> None:
+    import pandas as pd
+
+    from lca.bench import floor
+    from lca.paths import assets_dir
+
+    cells = "eval.cells=[{terrain: flat, difficulty: medium}, {terrain: uneven, difficulty: hard}]"
+    result = floor.run(["shipped=blind", "steps=3", "eval.units=4", cells], log=None)
+    shipped = pd.read_parquet(assets_dir() / "policies" / "blind" / "results.parquet")
+    assert [row["cell"] for row in result["cells"]] == ["flat-medium", "uneven-hard"]
+    for row in result["cells"]:
+        terrain, difficulty = row["cell"].split("-")
+        cell = shipped[(shipped.cell_terrain == terrain) & (shipped.cell_difficulty == difficulty)]
+        assert row["physics_s"] == pytest.approx(row["physics_per_unit_step"] * cell.steps.sum())
+        rounds = cell.groupby("episode").steps.max().sum()  # a round runs to its last unit
+        assert row["actor_s"] == pytest.approx(row["actor_per_step"] * rounds)
+        assert 0 < row["physics_share"] < 1
+    totals = result["totals_s"]
+    assert result["floor_min"] == pytest.approx(totals["physics"] / 2 / 60)
+    assert result["cells_min"] == pytest.approx(sum(totals.values()) / 2 / 60)
+    assert "physics alone (the floor)" in floor.table(result)
+
+
 def test_hardware_bench_times_both_ground_representations_on_the_same_trials() -> None:
     from lca.bench import hardware
 

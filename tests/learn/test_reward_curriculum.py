@@ -179,7 +179,7 @@ def test_boosts_fall_linearly_to_none_at_the_paper_weights():
     assert c.boosts["phase_contact"] == pytest.approx(2.5)
     c.update(100, 0.0)
     assert c.done and c.boosts == {}  # the table's weights exactly
-    assert c.shaping == (1.0, False, {})
+    assert c.shaping == (1.0, False, {}, 1.0)
 
 
 def test_a_boost_multiplies_its_term_only():
@@ -213,9 +213,72 @@ def test_a_boost_window_applies_late_and_ends_on_the_paper_weights():
     c.update(70, 0.0)
     assert c.boosts["track_lin_vel_xy_exp"] == pytest.approx(2.0)
     c.update(80, 0.0)
-    assert c.done and c.shaping == (1.0, False, {})  # and so to the end
+    assert c.done and c.shaping == (1.0, False, {}, 1.0)  # and so to the end
     c.update(99, 0.0)
     assert c.done
+
+
+def test_a_narrow_tracking_sigma_widens_to_the_papers_with_the_boosts():
+    cfg = RewardCurriculumConfig(
+        enabled=True,
+        by="iterations",
+        deadline=0.5,
+        boost={"track_lin_vel_xy_exp": 3.0},
+        boost_window=[0.0, 0.8],
+        sigma_scale=0.2,
+    )
+    c = RewardCurriculum(cfg, total_iterations=100)
+    c.update(0, 0.0)
+    assert c.sigma_scale == pytest.approx(0.2)
+    c.update(40, 0.0)
+    assert c.sigma_scale == pytest.approx(0.6) and not c.done
+    c.update(60, 0.0)  # penalties at the table's weights, the sigma still narrow
+    assert c.scale == 1.0 and c.sigma_scale == pytest.approx(0.8) and not c.done
+    c.update(80, 0.0)
+    assert c.done and c.shaping == (1.0, False, {}, 1.0)
+
+
+def test_a_narrow_sigma_pays_a_stall_far_less_than_a_walk():
+    """Standing still against 0.45 m/s earns 44 % of the velocity kernel at the paper's
+    sigma and 2 % at 0.2 x it; a walk 0.1 m/s short keeps most of it either way."""
+    from types import SimpleNamespace
+
+    from lca.task.config import RewardParams
+    from lca.task.rewards import track_lin_vel_xy_exp
+
+    command = np.array([[0.45, 0.0, 0.0], [0.45, 0.0, 0.0]])
+    vel = np.array([[0.0, 0.0, 0.0], [0.35, 0.0, 0.0]])
+
+    def kernel(sigma):
+        ctx = SimpleNamespace(
+            xp=np,
+            command=command,
+            state=SimpleNamespace(base_lin_vel=vel),
+            params=RewardParams(tracking_sigma=sigma),
+        )
+        return track_lin_vel_xy_exp(ctx)
+
+    stall, walk = kernel(0.25)
+    assert stall == pytest.approx(0.44, abs=0.01) and walk > 0.95
+    stall, walk = kernel(0.05)
+    assert stall < 0.02 and walk > 0.8
+
+
+def test_the_env_applies_the_sigma_scale(flat_cfg, flat_scene):
+    from lca.task.env import LocomotionEnv
+
+    env = LocomotionEnv(flat_cfg, scene=flat_scene)
+    paper = env.task_cfg.reward_params.tracking_sigma
+    env.set_reward_shaping(1.0, False, {}, 0.2)
+    assert env.reward_params.tracking_sigma == pytest.approx(0.2 * paper)
+    assert env.task_cfg.reward_params.tracking_sigma == paper  # the config is untouched
+    env.set_reward_shaping(1.0, False, {}, 1.0)
+    assert env.reward_params.tracking_sigma == pytest.approx(paper)
+
+
+def test_sigma_scale_must_be_positive():
+    with pytest.raises(ValueError, match="sigma_scale"):
+        RewardCurriculumConfig(enabled=True, sigma_scale=0.0).check()
 
 
 @pytest.mark.parametrize("window", [[0.5], [0.8, 0.6], [0.6, 1.0], [-0.1, 0.5]])
@@ -242,4 +305,4 @@ def test_the_default_recipe_ends_on_the_paper_objective(iterations):
         shaping.append((rewards.shaping, rewards.done, commands.ranges(it, task.commands)))
     assert shaping[0][1] is False and any(s[0][2] for s in shaping)  # devices were on
     end = int(0.9 * iterations)
-    assert all(s == ((1.0, False, {}), True, {}) for s in shaping[end:])
+    assert all(s == ((1.0, False, {}, 1.0), True, {}) for s in shaping[end:])

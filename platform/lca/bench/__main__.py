@@ -10,6 +10,7 @@ import sys
 from lca.paths import reports_dir
 
 BENCHMARKS = (
+    "floor",
     "sim",
     "env",
     "train",

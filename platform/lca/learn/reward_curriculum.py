@@ -86,27 +86,43 @@ class RewardCurriculum:
     @property
     def done(self) -> bool:
         """True once the objective is the paper's: full penalties, no clipping, no boost."""
-        return self.scale >= 1.0 and not self.only_positive and not self.boosts
+        return (
+            self.scale >= 1.0
+            and not self.only_positive
+            and not self.boosts
+            and self.sigma_scale == 1.0
+        )
+
+    def _boost_left(self) -> float:
+        """How much of the boosts' shaping is left: 1 at the start (of the window, if any),
+        falling to 0 once the penalties are the table's (at the window's end)."""
+        if not self.cfg.enabled:
+            return 0.0
+        if self.boost_window:
+            start, end = self.boost_window
+            if not start <= self.iteration < end:
+                return 0.0
+            return 1.0 - (self.iteration - start) / max(end - start, 1)
+        if self.scale >= 1.0 and not self.only_positive:
+            return 0.0
+        return 1.0 - self.progress
 
     @property
     def boosts(self) -> dict[str, float]:
         """Factors on the boosted terms' weights: the configured ones at the start (of the
         window, if any), 1 (none left) once the penalties are the table's (at its end)."""
-        c = self.cfg
-        if not c.enabled or not c.boost:
+        left = self._boost_left()
+        if not self.cfg.boost or left <= 0.0:
             return {}
-        if self.boost_window:
-            start, end = self.boost_window
-            if not start <= self.iteration < end:
-                return {}
-            left = 1.0 - (self.iteration - start) / max(end - start, 1)
-        elif self.scale >= 1.0 and not self.only_positive:
-            return {}
-        else:
-            left = 1.0 - self.progress
-        return {k: 1.0 + (float(f) - 1.0) * left for k, f in c.boost.items()}
+        return {k: 1.0 + (float(f) - 1.0) * left for k, f in self.cfg.boost.items()}
 
     @property
-    def shaping(self) -> tuple[float, bool, dict[str, float]]:
-        """What the env applies: (penalty scale, clipping, boosts)."""
-        return self.scale, self.only_positive, self.boosts
+    def sigma_scale(self) -> float:
+        """Factor on the tracking kernels' sigma: the configured one at the start, 1 (the
+        paper's) as the boosts end."""
+        return 1.0 + (float(self.cfg.sigma_scale) - 1.0) * self._boost_left()
+
+    @property
+    def shaping(self) -> tuple[float, bool, dict[str, float], float]:
+        """What the env applies: (penalty scale, clipping, boosts, sigma scale)."""
+        return self.scale, self.only_positive, self.boosts, self.sigma_scale

@@ -113,6 +113,10 @@ class RewardCurriculumConfig:
     # to 1 at `end` instead (e.g. [0.8, 0.9]: speed up a gait formed under the table's weights).
     # []: from the first iteration until the penalties are the table's
     boost_window: list[float] = field(default_factory=list)
+    # factor on the tracking kernels' sigma, on the boosts' schedule (back to 1 with them):
+    # 0.2 makes standing still at a 0.45 m/s command earn 2 % of the velocity kernel instead
+    # of the paper's 44 %, so a stall at a riser no longer pays nearly as well as a walk
+    sigma_scale: float = 1.0
     # terms added after the clip, like the termination penalty: their gradient reaches the
     # policy even while the clipped sum is negative (e.g. the posture terms, so that the
     # posture forms with the gait instead of after it)
@@ -146,6 +150,7 @@ class RewardCurriculumConfig:
             f"need [start, end] with 0 <= start < end < 1 (the run ends on the table's "
             f"weights), got {list(window)}",
         )
+        require(self.sigma_scale > 0, f"{key}.sigma_scale", f"must be > 0, got {self.sigma_scale}")
         for name, factor in self.boost.items():
             REWARD_TERMS.check(name, f"{key}.boost.{name}")
             require(factor > 0, f"{key}.boost.{name}", f"must be > 0, got {factor}")

@@ -9,6 +9,8 @@ Observation groups (TensorDict, batch [N]):
 
 from __future__ import annotations
 
+import copy
+
 import mujoco
 import numpy as np
 import torch
@@ -92,6 +94,7 @@ class LocomotionEnv(VecEnv):
         self._stateful_terms = [f.reset for f in fns if callable(getattr(f, "reset", None))]
         # the reward curriculum's knobs (lca.learn.reward_curriculum); the paper's: 1, False
         self.penalty_scale, self.boosts = 1.0, {}
+        self.sigma_scale, self.reward_params = 1.0, self.task_cfg.reward_params
         self.only_positive = bool(task.only_positive_rewards)
         self.scaled_terms = frozenset(task.reward_curriculum.terms) or None
         self.unclipped = frozenset(task.reward_curriculum.unclipped)
@@ -221,6 +224,8 @@ class LocomotionEnv(VecEnv):
         extras["log"]["Curriculum/command_floor"] = self.commands.min_speed
         for name, factor in self.boosts.items():
             extras["log"][f"Curriculum/boost_{name}"] = factor
+        if self.sigma_scale != 1.0:
+            extras["log"]["Curriculum/sigma_scale"] = self.sigma_scale
         self._reset_envs(done_ids)
         if done_ids.shape[0]:
             state = replace_rows(state, read_state(self.sim, self.contacts, done_ids), done_ids)
@@ -307,7 +312,7 @@ class LocomotionEnv(VecEnv):
             arm_ids=self.arm_ids,
             torso_ids=self.torso_ids,
             terminated=terminated,
-            params=self.task_cfg.reward_params,
+            params=self.reward_params,
             sim=self.sim,
         )
 
@@ -397,11 +402,20 @@ class LocomotionEnv(VecEnv):
         return self._obs
 
     def set_reward_shaping(
-        self, penalty_scale: float, only_positive: bool, boosts: dict | None = None
+        self,
+        penalty_scale: float,
+        only_positive: bool,
+        boosts: dict | None = None,
+        sigma_scale: float = 1.0,
     ) -> None:
-        """Reward curriculum: penalties x `penalty_scale`, boosted weights, clipping."""
+        """Reward curriculum: penalties x `penalty_scale`, boosted weights, clipping, the
+        tracking kernels' sigma x `sigma_scale`."""
         self.penalty_scale = float(penalty_scale)
         self.boosts = dict(boosts or {})
+        if float(sigma_scale) != self.sigma_scale:
+            self.sigma_scale = float(sigma_scale)
+            self.reward_params = copy.deepcopy(self.task_cfg.reward_params)
+            self.reward_params.tracking_sigma *= self.sigma_scale
         self.only_positive = bool(only_positive) or bool(self.task_cfg.only_positive_rewards)
 
     def set_perception(self, on: bool) -> None:
