@@ -195,15 +195,20 @@ def test_a_boost_multiplies_its_term_only():
     np.testing.assert_allclose(boosted - plain, [0.30, 0.0])
 
 
-def test_a_boost_window_applies_late_and_ends_on_the_paper_weights():
-    cfg = RewardCurriculumConfig(
+def tracking_boost(window: list[float], **extra) -> RewardCurriculumConfig:
+    """Velocity tracking x3 over `window`; the penalties at the table's from half-way."""
+    return RewardCurriculumConfig(
         enabled=True,
         by="iterations",
         deadline=0.5,
         boost={"track_lin_vel_xy_exp": 3.0},
-        boost_window=[0.6, 0.8],
+        boost_window=window,
+        **extra,
     )
-    c = RewardCurriculum(cfg, total_iterations=100)
+
+
+def test_a_boost_window_applies_late_and_ends_on_the_paper_weights():
+    c = RewardCurriculum(tracking_boost([0.6, 0.8]), total_iterations=100)
     c.update(10, 0.0)
     assert c.boosts == {} and not c.done  # the penalties still ramp; no boost before 60
     c.update(55, 0.0)
@@ -219,15 +224,7 @@ def test_a_boost_window_applies_late_and_ends_on_the_paper_weights():
 
 
 def test_a_narrow_tracking_sigma_widens_to_the_papers_with_the_boosts():
-    cfg = RewardCurriculumConfig(
-        enabled=True,
-        by="iterations",
-        deadline=0.5,
-        boost={"track_lin_vel_xy_exp": 3.0},
-        boost_window=[0.0, 0.8],
-        sigma_scale=0.2,
-    )
-    c = RewardCurriculum(cfg, total_iterations=100)
+    c = RewardCurriculum(tracking_boost([0.0, 0.8], sigma_scale=0.2), total_iterations=100)
     c.update(0, 0.0)
     assert c.sigma_scale == pytest.approx(0.2)
     c.update(40, 0.0)
