@@ -203,7 +203,11 @@ def summarise(run: RunDir, overrides: list[str], opts: dict, walked: dict | None
     on_terrain = cfg.terrain.name != "flat"
     variant = "terrain" if on_terrain else ""
     default = REPORTS / "bench" / ("walk_terrain.png" if on_terrain else "walk.png")
-    plot(evals, Path(opts["figure"] or default))
+    plot(
+        evals,
+        Path(opts["figure"] or default),
+        f"the {cfg.terrain.name} terrain" if on_terrain else "flat ground",
+    )
     train_s = float(curve["wall_s"].iloc[-1])
     return {
         "variant": variant,  # the result's file: walk.json, or walk_terrain.json on terrain
@@ -234,7 +238,7 @@ def summarise(run: RunDir, overrides: list[str], opts: dict, walked: dict | None
     }
 
 
-def plot(evals: pd.DataFrame, out: Path) -> None:
+def plot(evals: pd.DataFrame, out: Path, ground: str = "flat ground") -> None:
     out.parent.mkdir(parents=True, exist_ok=True)
     fig, axes = plt.subplots(1, 2, figsize=(11, 3.6))
     minutes = evals["train_wall_s"] / 60
@@ -264,7 +268,8 @@ def plot(evals: pd.DataFrame, out: Path) -> None:
         top.set_xlabel("environment steps (M)", fontsize=8)
     _plot_terrain_probes(axes[0], evals, minutes)
     fig.suptitle(
-        "Time to walk: blind MLP, scale=cpu (shaded: under the paper's objective)",
+        f"Time to walk on {ground}: blind MLP, the walk recipe "
+        "(shaded: under the paper's objective)",
         fontsize=11,
     )
     fig.tight_layout()
