@@ -20,13 +20,12 @@ import time
 from pathlib import Path
 
 import torch
-from omegaconf import OmegaConf
 
 from lca.arrays import to_numpy
 from lca.cli import split_option
 from lca.config import ConfigError
 from lca.evaluate.clips import Setting, cell_setting, save, shoot
-from lca.evaluate.config import EvalCell, EvalConfig
+from lca.evaluate.config import parse_cell
 from lca.evaluate.hardware import hardware_setting
 from lca.evaluate.policy import final_checkpoint, load_run_config
 from lca.evaluate.protocol import cell_name
@@ -37,20 +36,6 @@ USAGE = (
     "usage: python -m lca.play run_dir=<run> [cell=<terrain>-<difficulty> | task=<hardware "
     "task>] [out=PATH.mp4] [seconds=S] [--viewer] [key=value ...]"
 )
-
-
-def parse_cell(text: str):
-    """'stairs-hard' -> the EvalCell (terrain, difficulty), checked as the eval config checks
-    its cells; ConfigError naming the allowed values."""
-    terrain, _, difficulty = text.rpartition("-")
-    cell = EvalCell(terrain or text, difficulty)
-    try:
-        EvalConfig(cells=[cell]).check()
-    except ConfigError as error:
-        raise ConfigError(
-            f"cell: '{text}' is not <terrain>-<difficulty> (e.g. stairs-hard): {error}"
-        ) from None
-    return OmegaConf.structured(cell)
 
 
 def _one(args: list[str], key: str) -> tuple[str | None, list[str]]:

@@ -32,3 +32,21 @@ def test_diagnosis_holds_each_command_and_pays_per_second(evaluated_run, capsys)
 def test_diagnosis_usage_error(capsys):
     assert diagnose.main(["units=2"]) == 2
     assert "run_dir=" in capsys.readouterr().err
+
+
+def test_diagnosis_on_a_terrain_cell_writes_beside_the_flat_one(evaluated_run, capsys):
+    _, run_path, _ = evaluated_run
+    assert diagnose.main([f"run_dir={run_path}", "cell=stairs-medium", "units=2", "steps=30"]) == 0
+    out = run_path / "diagnosis" / "stairs-medium"
+    terms = pd.read_csv(out / "terms.csv", index_col="term")
+    assert list(terms.columns) == list(diagnose.COMMANDS)
+    assert "(stairs-medium, deterministic policy)" in capsys.readouterr().out
+    _, env = diagnose.diagnosis_env(run_path, 2, 30, diagnose.parse_cell("stairs-medium"))
+    cfg = env.cfg.to_dict()
+    assert (cfg["terrain"]["name"], cfg["difficulty"]["name"]) == ("stairs", "medium")
+
+
+def test_diagnosis_names_the_allowed_cells(evaluated_run, capsys):
+    _, run_path, _ = evaluated_run
+    assert diagnose.main([f"run_dir={run_path}", "cell=stairs-steep"]) == 2
+    assert "allowed: ['hard', 'medium']" in capsys.readouterr().err

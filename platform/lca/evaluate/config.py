@@ -4,11 +4,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from omegaconf import MISSING
+from omegaconf import MISSING, OmegaConf
 
 from lca.config.errors import check_range, require
 from lca.config.registry import eval_terrain_names
-from lca.config.schema import group
+from lca.config.schema import ConfigValueError, group
 from lca.paths import assets_dir, conf_dir
 
 
@@ -89,3 +89,17 @@ class EvalConfig:
                 f"unknown '{cell.difficulty}'; allowed: {levels}",
             )
         check_range("eval.command_x", self.command_x, -1e9)
+
+
+def parse_cell(text: str) -> EvalCell:
+    """'stairs-hard' -> the EvalCell (terrain, difficulty), checked as the eval config checks
+    its cells; ConfigValueError (lca.config.ConfigError) naming the allowed values."""
+    terrain, _, difficulty = text.rpartition("-")
+    cell = EvalCell(terrain or text, difficulty)
+    try:
+        EvalConfig(cells=[cell]).check()
+    except ConfigValueError as error:
+        raise ConfigValueError(
+            f"cell: '{text}' is not <terrain>-<difficulty> (e.g. stairs-hard): {error}"
+        ) from None
+    return OmegaConf.structured(cell)

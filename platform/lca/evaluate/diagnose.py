@@ -1,16 +1,20 @@
 """What a policy does with each command, and what the paper's reward pays it for doing it.
 
-    python -m lca.evaluate.diagnose run_dir=<dir> [checkpoint=<path>] [units=16] [steps=300]
+    python -m lca.evaluate.diagnose run_dir=<dir> [checkpoint=<path>] [cell=flat-medium]
+        [units=16] [steps=300]
 
-The deterministic policy runs on the flat cell (the protocol's observation noise, no
-randomisation) under each command of `COMMANDS`, held fixed. Per command it reports the base
-velocity it reaches (mean over the units' steps after the first second, base frame) and every
-reward term per second of simulated time under the paper's table (no curriculum, no clip),
-over the steps before a unit's first termination. A flat-cell evaluation sees only forward
-commands; this shows whether a walker follows what it is told (zero: stand; backward,
-sideways, turn) and which terms of the table it pays for its posture.
+The deterministic policy runs on an evaluation cell (default the flat one; the protocol's
+observation noise, no randomisation) under each command of `COMMANDS`, held fixed. Per
+command it reports the base velocity it reaches (mean over the units' steps after the first
+second, base frame) and every reward term per second of simulated time under the paper's
+table (no curriculum, no clip), over the steps before a unit's first termination. A
+flat-cell evaluation sees only forward commands; this shows whether a walker follows what it
+is told (zero: stand; backward, sideways, turn) and which terms of the table it pays for its
+posture. On a terrain cell (`cell=stairs-medium`) it shows what crossing that terrain costs
+against standing at the spawn, and `alive_s` how long the units last there.
 
-Writes `<run>/diagnosis/commands.csv` and `terms.csv` and prints both as tables.
+Writes `<run>/diagnosis/commands.csv` and `terms.csv` (another cell than the flat one:
+`<run>/diagnosis/<cell>/`) and prints both as tables.
 """
 
 from __future__ import annotations
@@ -25,9 +29,10 @@ import torch
 
 from lca.arrays import like, to_numpy
 from lca.cli import split_option
-from lca.evaluate.config import EvalCell
+from lca.config import ConfigError
+from lca.evaluate.config import EvalCell, parse_cell
 from lca.evaluate.policy import final_checkpoint, load_policy, load_run_config
-from lca.evaluate.protocol import cell_config
+from lca.evaluate.protocol import cell_config, cell_name
 from lca.evaluate.rollout import rollout, start
 from lca.store import write_atomically
 from lca.task.env import LocomotionEnv
@@ -44,11 +49,14 @@ COMMANDS = {
 SETTLE_S = 1.0  # the velocity is averaged after this, once the gait has started
 
 
-def diagnosis_env(run_dir: Path, units: int, steps: int) -> tuple:
-    """The run's config turned into the flat cell with `units` units and `steps` steps."""
+FLAT = EvalCell("flat", "medium")
+
+
+def diagnosis_env(run_dir: Path, units: int, steps: int, cell: EvalCell = FLAT) -> tuple:
+    """The run's config turned into `cell` with `units` units and `steps` steps."""
     cfg = load_run_config(run_dir)
     cfg.eval.units, cfg.eval.steps = int(units), int(steps)
-    env = LocomotionEnv(cell_config(cfg, EvalCell("flat", "medium")))
+    env = LocomotionEnv(cell_config(cfg, cell))
     env.set_perception(False)
     return cfg, env
 
@@ -90,11 +98,15 @@ def hold_command(
 
 
 def diagnose(
-    run_dir: Path, checkpoint: Path | None = None, units: int = 16, steps: int = 300
+    run_dir: Path,
+    checkpoint: Path | None = None,
+    units: int = 16,
+    steps: int = 300,
+    cell: EvalCell = FLAT,
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """(commands: one row per command, with the reached velocity; terms: reward per second,
     one row per term and a `total` row, one column per command)."""
-    cfg, env = diagnosis_env(run_dir, units, steps)
+    cfg, env = diagnosis_env(run_dir, units, steps, cell)
     policy = load_policy(cfg, env, checkpoint or final_checkpoint(run_dir))
     rows, terms = [], {}
     for label, command in COMMANDS.items():
@@ -113,21 +125,30 @@ def main(argv: list[str] | None = None) -> int:
     checkpoints, args = split_option(args, "checkpoint")
     units, args = split_option(args, "units")
     steps, args = split_option(args, "steps")
+    cells, args = split_option(args, "cell")
     if len(run_dirs) != 1 or args:
         print(__doc__.strip().splitlines()[2], file=sys.stderr)
         return 2
     run_dir = Path(run_dirs[0])
+    try:
+        cell = parse_cell(cells[-1]) if cells else FLAT
+    except ConfigError as error:
+        print(error, file=sys.stderr)
+        return 2
     commands, terms = diagnose(
         run_dir,
         Path(checkpoints[-1]) if checkpoints else None,
         int(units[-1]) if units else 16,
         int(steps[-1]) if steps else 300,
+        cell,
     )
     out = run_dir / "diagnosis"
+    if cell_name(cell) != cell_name(FLAT):
+        out = out / cell_name(cell)
     write_atomically(out / "commands.csv", lambda p: commands.to_csv(p, index=False), ".csv")
     write_atomically(out / "terms.csv", terms.to_csv, ".csv")
     print(commands.round(3).to_string(index=False))
-    print("\nreward per second under the paper's table (deterministic policy):")
+    print(f"\nreward per second under the paper's table ({cell_name(cell)}, deterministic policy):")
     print(terms.round(3).to_string())
     return 0
 
