@@ -9,6 +9,7 @@ from _cli import SMOKE
 
 from lca.bench import walk
 from lca.bench.__main__ import result_name
+from lca.store import RunDir
 
 pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
 
@@ -64,7 +65,7 @@ def test_walking_on_terrain_needs_stairs_and_uneven():
     assert walk.walks({**row, "stairs_success": float("nan"), "uneven_success": float("nan")})
 
 
-def test_a_run_on_terrain_is_probed_on_stairs_and_uneven(tmp_path):
+def test_a_run_on_terrain_is_probed_on_stairs_and_uneven(tmp_path, monkeypatch):
     out = walk.run(
         [
             *SMOKE,
@@ -85,6 +86,13 @@ def test_a_run_on_terrain_is_probed_on_stairs_and_uneven(tmp_path):
         assert 0.0 <= probes[key].iloc[0] <= 100.0, probes.to_dict()
     # its own result file, so a terrain run does not overwrite the flat time-to-walk
     assert result_name("walk", out) == "walk_terrain.json"
+    # and a lever's run names its own, figure included
+    opts = {**walk.OPTIONS, "variant": "terrain_r5"}
+    monkeypatch.setattr(walk, "REPORTS", tmp_path)
+    (tmp_path / "bench").mkdir()
+    again = walk.summarise(RunDir(tmp_path / "run"), [], opts, None)
+    assert result_name("walk", again) == "walk_terrain_r5.json"
+    assert (tmp_path / "bench" / "walk_terrain_r5.png").exists()
 
 
 def test_a_terrain_runs_figure_plots_its_stairs_and_uneven_probes(tmp_path, monkeypatch):

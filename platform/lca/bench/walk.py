@@ -3,7 +3,7 @@ or (`terrain=mixed`) on the paper's terrain.
 
     python -m lca.bench walk [--json] [overrides] [cap_s=10800] [eval_every_s=240]
         [iterations=2450] [until=0] [eval_from=0] [run=runs/bench_walk] [resume=false]
-        [stop=true]
+        [stop=true] [variant=<name>] [figure=<png>]
 
 Every `eval_every_s` of training wall-clock the current policy is evaluated in-process with
 the paper's protocol on a flat cell (forward commands 0.3-0.6 m/s, 1000-step episodes,
@@ -12,9 +12,9 @@ counted. The policy *walks* at the first evaluation with success >= 90 %, tracki
 <= 20 cm/s and a base speed <= 20 cm/s when told to stand, while the objective is the paper's
 (the reward curriculum, if any, has finished). Trained on terrain, it is also probed on
 stairs and uneven terrain at medium difficulty and walks only with >= 80 % success on each.
-Reports time_to_walk_s,
-steps_to_walk, steps/s, writes the curve figure reports/bench/walk.png (walk_terrain.png and
-walk_terrain.json on terrain, so the flat result stays) and the run directory (a complete run:
+Reports time_to_walk_s, steps_to_walk, steps/s, writes the curve figure
+reports/bench/walk.png (walk_terrain.png and walk_terrain.json on terrain, so the flat result
+stays; `variant=terrain_r5`: walk_terrain_r5.*) and the run directory (a complete run:
 config, provenance, curve, checkpoints, exported policy).
 """
 
@@ -78,7 +78,10 @@ OPTIONS = {
     "run": "runs/bench_walk",
     "resume": "false",
     "stop": "true",
-    "figure": "",  # default: reports/bench/walk.png, walk_terrain.png for a run on terrain
+    # the result's name: walk_<variant>.json and .png (default: walk, walk_terrain on
+    # terrain), so that a lever's run does not overwrite the recipe's result
+    "variant": "",
+    "figure": "",  # default: reports/bench/walk_<variant>.png
 }
 
 
@@ -201,8 +204,8 @@ def summarise(run: RunDir, overrides: list[str], opts: dict, walked: dict | None
     curve = pd.read_csv(run.curve)
     evals = pd.read_csv(run.path / "probe_evals.csv")
     on_terrain = cfg.terrain.name != "flat"
-    variant = "terrain" if on_terrain else ""
-    default = REPORTS / "bench" / ("walk_terrain.png" if on_terrain else "walk.png")
+    variant = opts["variant"] or ("terrain" if on_terrain else "")
+    default = REPORTS / "bench" / (f"walk_{variant}.png" if variant else "walk.png")
     plot(
         evals,
         Path(opts["figure"] or default),
@@ -210,7 +213,7 @@ def summarise(run: RunDir, overrides: list[str], opts: dict, walked: dict | None
     )
     train_s = float(curve["wall_s"].iloc[-1])
     return {
-        "variant": variant,  # the result's file: walk.json, or walk_terrain.json on terrain
+        "variant": variant,  # the result's file: walk.json, walk_<variant>.json
         "overrides": overrides,
         "walked": walked is not None,
         "time_to_walk_s": walked["train_wall_s"] if walked else None,
