@@ -142,13 +142,12 @@ def main(argv: list[str] | None = None) -> int:
         int(steps[-1]) if steps else 300,
         cell,
     )
-    out = run_dir / "diagnosis"
-    if cell_name(cell) != cell_name(FLAT):
-        out = out / cell_name(cell)
+    name = cell_name(cell)
+    out = run_dir / "diagnosis" if name == cell_name(FLAT) else run_dir / "diagnosis" / name
     write_atomically(out / "commands.csv", lambda p: commands.to_csv(p, index=False), ".csv")
     write_atomically(out / "terms.csv", terms.to_csv, ".csv")
     print(commands.round(3).to_string(index=False))
-    print(f"\nreward per second under the paper's table ({cell_name(cell)}, deterministic policy):")
+    print(f"\nreward per second under the paper's table ({name}, deterministic policy):")
     print(terms.round(3).to_string())
     return 0
 
