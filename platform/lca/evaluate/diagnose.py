@@ -143,7 +143,9 @@ def main(argv: list[str] | None = None) -> int:
         cell,
     )
     name = cell_name(cell)
-    out = run_dir / "diagnosis" if name == cell_name(FLAT) else run_dir / "diagnosis" / name
+    out = run_dir / "diagnosis"
+    if name != cell_name(FLAT):  # a flat diagnosis keeps its path; others get their own folder
+        out = out / name
     write_atomically(out / "commands.csv", lambda p: commands.to_csv(p, index=False), ".csv")
     write_atomically(out / "terms.csv", terms.to_csv, ".csv")
     print(commands.round(3).to_string(index=False))
