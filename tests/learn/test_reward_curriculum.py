@@ -87,7 +87,8 @@ def test_training_run_ends_on_the_paper_objective(tmp_path, smoke_scene):
     trainer.train()
     rows = read_curve(tmp_path / "run" / "train_curve.csv")
     assert [float(r["penalty_scale"]) for r in rows] == [0.3, 0.3, 1.0, 1.0]
-    assert trainer.env.penalty_scale == 1.0 and not trainer.env.only_positive
+    assert trainer.env.reward_manager.penalty_scale == 1.0
+    assert not trainer.env.reward_manager.only_positive
     assert all(float(r["learning_rate"]) > 0 for r in rows)
     assert all(np.isfinite(float(r["kl"])) for r in rows)  # the adaptive schedule's KL
 
@@ -266,11 +267,11 @@ def test_the_env_applies_the_sigma_scale(flat_cfg, flat_scene):
 
     env = LocomotionEnv(flat_cfg, scene=flat_scene)
     paper = env.task_cfg.reward_params.tracking_sigma
-    env.set_reward_shaping(1.0, False, {}, 0.2)
-    assert env.reward_params.tracking_sigma == pytest.approx(0.2 * paper)
+    env.reward_manager.set_shaping(1.0, False, {}, 0.2)
+    assert env.reward_manager.params.tracking_sigma == pytest.approx(0.2 * paper)
     assert env.task_cfg.reward_params.tracking_sigma == paper  # the config is untouched
-    env.set_reward_shaping(1.0, False, {}, 1.0)
-    assert env.reward_params.tracking_sigma == pytest.approx(paper)
+    env.reward_manager.set_shaping(1.0, False, {}, 1.0)
+    assert env.reward_manager.params.tracking_sigma == pytest.approx(paper)
 
 
 def test_sigma_scale_must_be_positive():

@@ -83,15 +83,15 @@ def test_task_on_warp_matches_the_task_on_mjbatch(mixed_cfg) -> None:
     for _ in range(20):
         for group in obs_c.keys():  # noqa: SIM118 (a TensorDict)
             torch.testing.assert_close(obs_w[group].cpu(), obs_c[group], atol=0.25, rtol=0)
-        before = {k: v.copy() for k, v in plain.episode_sums.items()}
-        before_w = {k: to_numpy(v).copy() for k, v in warp.episode_sums.items()}
+        before = {k: v.copy() for k, v in plain.reward_manager.episode_sums.items()}
+        before_w = {k: to_numpy(v).copy() for k, v in warp.reward_manager.episode_sums.items()}
         action = 0.3 * torch.randn(WORLDS, plain.num_actions, generator=generator)
         obs_c, _, done_c, _ = plain.step(action)
         obs_w, _, done_w, _ = warp.step(action)
         assert not done_c.any() and not done_w.any()
-        for name, sums in plain.episode_sums.items():
+        for name, sums in plain.reward_manager.episode_sums.items():
             np.testing.assert_allclose(
-                to_numpy(warp.episode_sums[name]) - before_w[name],
+                to_numpy(warp.reward_manager.episode_sums[name]) - before_w[name],
                 sums - before[name],
                 atol=0.02,
                 err_msg=name,

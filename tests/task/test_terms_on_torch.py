@@ -69,7 +69,7 @@ def test_every_reward_term_and_the_total_agree(stepped, dtype):
     tctx = torch_copy(ctx, dtype)
     # the table's terms (a test elsewhere may register a NumPy-only plugin)
     names = [n for n in REWARD_TERMS.names() if REWARD_TERMS[n].__module__ == rewards.__name__]
-    assert set(env.weights) <= set(names)
+    assert set(env.reward_manager.weights) <= set(names)
     for name in names:
         close(REWARD_TERMS[name](tctx), REWARD_TERMS[name](ctx), dtype)
     assert np.ptp(REWARD_TERMS["phase_contact"](ctx)) > 0  # contacts differ between envs
@@ -79,8 +79,8 @@ def test_every_reward_term_and_the_total_agree(stepped, dtype):
         unclipped=frozenset({"feet_flat"}),
         boosts={"track_lin_vel_xy_exp": 2.0},
     )
-    total, terms = compute_rewards(ctx, env.weights, env.dt, **shaping)
-    ttotal, tterms = compute_rewards(tctx, env.weights, env.dt, **shaping)
+    total, terms = compute_rewards(ctx, env.reward_manager.weights, env.dt, **shaping)
+    ttotal, tterms = compute_rewards(tctx, env.reward_manager.weights, env.dt, **shaping)
     close(ttotal, total, dtype)
     for name, value in terms.items():
         close(tterms[name], value, dtype)

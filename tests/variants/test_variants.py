@@ -142,7 +142,8 @@ def test_a_term_reads_new_state_from_the_live_physics(example_variants) -> None:
     mujoco.mj_kinematics(env.sim.model, data)
     torso = data.xpos[env.sim.body_id("torso_link"), 2]
     assert 0.5 < torso < 1.5
-    got = env.episode_sums["body_below"][0] / env.dt  # weight -1: minus the term, once
+    # weight -1: minus the term, once
+    got = env.reward_manager.episode_sums["body_below"][0] / env.dt
     assert got == pytest.approx(-(5.0 - torso), abs=0.05)  # xpos: the step's start
     with pytest.raises(KeyError, match="no body 'tail'"):
         env.sim.body_id("tail")

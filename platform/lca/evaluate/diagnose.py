@@ -72,15 +72,15 @@ def hold_command(
     alive = np.ones(env.num_envs, dtype=bool)
     settle = round(SETTLE_S / env.dt)
     velocity, counted = np.zeros(3), 0
-    sums = {name: 0.0 for name in env.episode_sums}
-    before = {name: to_numpy(s).copy() for name, s in env.episode_sums.items()}
+    sums = {name: 0.0 for name in env.reward_manager.episode_sums}
+    before = {name: to_numpy(s).copy() for name, s in env.reward_manager.episode_sums.items()}
     command = like(np.asarray(command, dtype=np.float64), env.commands.value)
     env.commands.value[:] = command
     env.commands.time_left[:] = math.inf
     alive_steps = 0
     for step, m in rollout(env, policy, obs, steps):
         alive &= ~(m["terminated"] | m["time_out"])
-        for name, s in env.episode_sums.items():
+        for name, s in env.reward_manager.episode_sums.items():
             s = to_numpy(s)
             sums[name] += float(np.sum((s - before[name])[alive]))
             before[name] = s.copy()

@@ -211,7 +211,7 @@ class Trainer(Checkpoints):
             length = self.last.get("mean_episode_length", math.nan)
             progress = self.last.get("tracking_progress", math.nan)
             self.rewards.update(it, float(length) / env.max_episode_length, float(progress))
-            env.set_reward_shaping(*self.rewards.shaping)
+            env.reward_manager.set_shaping(*self.rewards.shaping)
             env.commands.min_speed = self.commands.floor(it)
             if env.terrain_levels is not None:
                 env.terrain_levels.over = it >= cfg.terrain.levels_end * self.total

@@ -9,8 +9,6 @@ Observation groups (TensorDict, batch [N]):
 
 from __future__ import annotations
 
-import copy
-
 import mujoco
 import numpy as np
 import torch
@@ -19,7 +17,6 @@ from rsl_rl.env import VecEnv
 from tensordict import TensorDict
 
 from lca.arrays import Array, as_float, draw, generator, like, namespace, zeros
-from lca.config.registry import REWARD_TERMS
 from lca.config.runtime import resolve_device
 from lca.sim.backend import make_sim
 from lca.sim.scene import Scene, build_scene
@@ -27,7 +24,8 @@ from lca.task import heightmap, observations
 from lca.task.actions import action_scales, joint_ids
 from lca.task.commands import VelocityCommand, gait_phase
 from lca.task.deployment_map import DeploymentMap
-from lca.task.rewards import RewardContext, compute_rewards, weights_and_params
+from lca.task.reward_manager import RewardManager
+from lca.task.rewards import RewardContext
 from lca.task.state import (
     ContactAccumulator,
     RobotState,
@@ -88,16 +86,7 @@ class LocomotionEnv(VecEnv):
         mid, half = (lower + upper) / 2, (upper - lower) / 2 * task.reward_params.soft_limit_factor
         self.joint_lower, self.joint_upper = like(mid - half, ref), like(mid + half, ref)
         self._bad_warning_ids = self._ids(BAD_STATE_WARNINGS)
-        self.weights, self.reward_term_params = weights_and_params(task.rewards)
-        self.reward_fns = {name: REWARD_TERMS[name] for name in self.weights}
-        fns = self.reward_fns.values()
-        self._stateful_terms = [f.reset for f in fns if callable(getattr(f, "reset", None))]
-        # the reward curriculum's knobs (lca.learn.reward_curriculum); the paper's: 1, False
-        self.penalty_scale, self.boosts = 1.0, {}
-        self.sigma_scale, self.reward_params = 1.0, self.task_cfg.reward_params
-        self.only_positive = bool(task.only_positive_rewards)
-        self.scaled_terms = frozenset(task.reward_curriculum.terms) or None
-        self.unclipped = frozenset(task.reward_curriculum.unclipped)
+        self.reward_manager = RewardManager(task, self.num_envs, ref)
         self.perception = bool(task.perception)
         # evaluation turns it off: only the actor's observations (no critic map, no history)
         self.observe_critic = True
@@ -130,7 +119,6 @@ class LocomotionEnv(VecEnv):
         self._episode_steps = self._zeros(self.num_envs, dtype=self.xp.int64)
         self.action = self._zeros((self.num_envs, self.num_actions))
         self.last_action = self._zeros((self.num_envs, self.num_actions))
-        self.episode_sums: dict[str, Array] = {k: self._zeros(self.num_envs) for k in self.weights}
         self.nonfinite_resets = 0  # envs reset from a non-finite state (actions included)
         self.nonfinite_actions = 0  # env steps whose action held a NaN or inf
         self._push_steps = (
@@ -181,21 +169,7 @@ class LocomotionEnv(VecEnv):
         terminated = fallen | broken
         time_out = (self._episode_steps >= self.max_episode_length) & ~terminated
 
-        ctx = self._reward_context(state, terminated)
-        reward, terms = compute_rewards(
-            ctx,
-            self.weights,
-            self.dt,
-            only_positive=self.only_positive,
-            penalty_scale=self.penalty_scale,
-            scaled_terms=self.scaled_terms,
-            unclipped=self.unclipped,
-            params=self.reward_term_params,
-            boosts=self.boosts,
-            fns=self.reward_fns,
-        )
-        for name, value in terms.items():
-            self.episode_sums[name] += value
+        reward = self.reward_manager.compute(self._reward_context(state, terminated), self.dt)
 
         done = terminated | time_out
         strike = self.task_cfg.reward_params.strike_threshold
@@ -219,13 +193,8 @@ class LocomotionEnv(VecEnv):
         extras["metrics"]["fell"] = fallen
         extras["metrics"]["nonfinite"] = broken
         extras["metrics"]["nonfinite_action"] = bad_action
-        extras["log"]["Curriculum/penalty_scale"] = self.penalty_scale
-        extras["log"]["Curriculum/only_positive"] = float(self.only_positive)
-        extras["log"]["Curriculum/command_floor"] = self.commands.min_speed
-        for name, factor in self.boosts.items():
-            extras["log"][f"Curriculum/boost_{name}"] = factor
-        if self.sigma_scale != 1.0:
-            extras["log"]["Curriculum/sigma_scale"] = self.sigma_scale
+        log |= self.reward_manager.curriculum_log()
+        log["Curriculum/command_floor"] = self.commands.min_speed
         self._reset_envs(done_ids)
         if done_ids.shape[0]:
             state = replace_rows(state, read_state(self.sim, self.contacts, done_ids), done_ids)
@@ -278,10 +247,7 @@ class LocomotionEnv(VecEnv):
             self.camera_map.restart(ids)
         self.action[ids] = 0.0
         self.last_action[ids] = 0.0
-        for sums in self.episode_sums.values():
-            sums[ids] = 0.0
-        for reset in self._stateful_terms:  # reward terms that keep per-env state
-            reset(ids)
+        self.reward_manager.reset(ids)
 
     def _maybe_push(self) -> None:
         if self._push_steps <= 0:
@@ -312,13 +278,13 @@ class LocomotionEnv(VecEnv):
             arm_ids=self.arm_ids,
             torso_ids=self.torso_ids,
             terminated=terminated,
-            params=self.reward_params,
+            params=self.reward_manager.params,
             sim=self.sim,
         )
 
     def _episode_log(self, ids: Array, fallen: Array, time_out: Array) -> dict:
         mean = self.xp.mean
-        log = {f"Episode_Reward/{k}": mean(sums[ids]) for k, sums in self.episode_sums.items()}
+        log = self.reward_manager.episode_log(ids)
         log["Episode_Termination/fall"] = mean(as_float(fallen[ids], self._ref))
         log["Episode_Termination/time_out"] = mean(as_float(time_out[ids], self._ref))
         return log
@@ -400,23 +366,6 @@ class LocomotionEnv(VecEnv):
         self.critic_history.buffer[:] = 0.0
         self._obs = self._observe(read_state(self.sim, self.contacts))
         return self._obs
-
-    def set_reward_shaping(
-        self,
-        penalty_scale: float,
-        only_positive: bool,
-        boosts: dict | None = None,
-        sigma_scale: float = 1.0,
-    ) -> None:
-        """Reward curriculum: penalties x `penalty_scale`, boosted weights, clipping, the
-        tracking kernels' sigma x `sigma_scale`."""
-        self.penalty_scale = float(penalty_scale)
-        self.boosts = dict(boosts or {})
-        if float(sigma_scale) != self.sigma_scale:
-            self.sigma_scale = float(sigma_scale)
-            self.reward_params = copy.deepcopy(self.task_cfg.reward_params)
-            self.reward_params.tracking_sigma *= self.sigma_scale
-        self.only_positive = bool(only_positive) or bool(self.task_cfg.only_positive_rewards)
 
     def set_perception(self, on: bool) -> None:
         """Curriculum switch: when off the actor's map is exactly zero; the critic keeps its map.

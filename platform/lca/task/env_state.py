@@ -17,7 +17,8 @@ import torch
 from lca.arrays import copy_of, like, rng_state, set_rng_state
 
 ARRAYS = ("_episode_steps", "action", "last_action")
-COUNTERS = ("nonfinite_resets", "nonfinite_actions", "penalty_scale", "only_positive")
+COUNTERS = ("nonfinite_resets", "nonfinite_actions")
+SHAPING = ("penalty_scale", "only_positive")  # the reward manager's
 LEVEL_TRACKS = ("path", "asked", "lived", "mark")  # TerrainLevels' per-episode distances
 
 
@@ -35,7 +36,7 @@ def env_state(env) -> dict:
             "time_left": copy_of(env.commands.time_left),
             "min_speed": env.commands.min_speed,
         },
-        "episode_sums": {k: copy_of(v) for k, v in env.episode_sums.items()},
+        "episode_sums": {k: copy_of(v) for k, v in env.reward_manager.episode_sums.items()},
         "perception": env.perception,
         "obs": {k: v.clone() for k, v in env._obs.items()},
         "robot_state": copy.deepcopy(vars(env._state)),
@@ -46,6 +47,7 @@ def env_state(env) -> dict:
     }
     state |= {name: copy_of(getattr(env, name)) for name in ARRAYS}
     state |= {name: getattr(env, name) for name in COUNTERS}
+    state |= {name: getattr(env.reward_manager, name) for name in SHAPING}
     if env.terrain_levels is not None:
         levels = env.terrain_levels
         state["terrain_levels"] = {
@@ -81,11 +83,13 @@ def restore_env_state(env, state: dict) -> None:
     env.commands.time_left[:] = state["commands"]["time_left"]
     env.commands.min_speed = state["commands"]["min_speed"]
     for name, sums in state["episode_sums"].items():
-        env.episode_sums[name][:] = sums
+        env.reward_manager.episode_sums[name][:] = sums
     for name in ARRAYS:
         getattr(env, name)[:] = state[name]
     for name in COUNTERS:
         setattr(env, name, state[name])
+    for name in SHAPING:
+        setattr(env.reward_manager, name, state[name])
     if state.get("terrain_levels") is not None:
         env.terrain_levels.level[:] = state["terrain_levels"]["level"]
         sim.env_origin[:] = state["terrain_levels"]["origin"]
