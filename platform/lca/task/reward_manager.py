@@ -26,6 +26,7 @@ class RewardManager:
         self.only_positive = self.always_positive
         self.scaled_terms = frozenset(task.reward_curriculum.terms) or None
         self.unclipped = frozenset(task.reward_curriculum.unclipped)
+        self.xp = namespace(ref)
         self.episode_sums: dict[str, Array] = {k: zeros(num_envs, ref) for k in self.weights}
 
     def set_shaping(
@@ -71,9 +72,7 @@ class RewardManager:
 
     def episode_log(self, ids: Array) -> dict:
         """The mean of each term's episode sum over the episodes `ids` that just ended."""
-        if not self.episode_sums:
-            return {}
-        mean = namespace(next(iter(self.episode_sums.values()))).mean
+        mean = self.xp.mean
         return {f"Episode_Reward/{k}": mean(sums[ids]) for k, sums in self.episode_sums.items()}
 
     def curriculum_log(self) -> dict:
