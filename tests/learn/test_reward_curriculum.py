@@ -4,8 +4,11 @@ objective and logs the scale, the learning rate and the KL."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
+import torch
 
 from lca.config import ConfigError
 from lca.learn.command_curriculum import CommandCurriculum
@@ -91,6 +94,32 @@ def test_training_run_ends_on_the_paper_objective(tmp_path, smoke_scene):
     assert not trainer.env.reward_manager.only_positive
     assert all(float(r["learning_rate"]) > 0 for r in rows)
     assert all(np.isfinite(float(r["kl"])) for r in rows)  # the adaptive schedule's KL
+
+
+@pytest.mark.slow  # trains: see README
+def test_the_paper_phase_warms_the_critic_then_holds_a_low_rate(tmp_path, smoke_scene):
+    """algo.final_*: from the cut (iteration 2 of 5) the critic trains alone for one
+    iteration, then the actor too, at the fixed final learning rate."""
+    cfg = smoke_cfg(
+        "scale.max_iterations=5",
+        "task.reward_curriculum.enabled=true",
+        "task.reward_curriculum.by=iterations",
+        "task.reward_curriculum.cut=0.4",
+        "algo.final_critic_warmup=1",
+        "algo.final_learning_rate=2.0e-5",
+    )
+    trainer = make_trainer(cfg, tmp_path / "run", smoke_scene)
+    actor = []
+    trainer.train(
+        hook=lambda t, it, row: actor.append(t.alg.actor.state_dict()["mlp.0.weight"].clone())
+    )
+    rows = read_curve(tmp_path / "run" / "train_curve.csv")
+    assert [float(r["penalty_scale"]) < 1 for r in rows] == [True, True, False, False, False]
+    assert [float(r["learning_rate"]) for r in rows][2:] == [2.0e-5] * 3
+    assert float(rows[1]["learning_rate"]) != 2.0e-5
+    moved = [not torch.equal(a, b) for a, b in zip(actor, actor[1:], strict=False)]
+    assert moved == [True, False, True, True]  # iteration 2 trained the critic only
+    assert trainer.alg.schedule == "fixed"
 
 
 def test_iteration_ramp_is_linear_to_the_deadline():
@@ -272,6 +301,55 @@ def test_the_env_applies_the_sigma_scale(flat_cfg, flat_scene):
     assert env.task_cfg.reward_params.tracking_sigma == paper  # the config is untouched
     env.reward_manager.set_shaping(1.0, False, {}, 1.0)
     assert env.reward_manager.params.tracking_sigma == pytest.approx(paper)
+
+
+def test_a_cut_ends_every_shaping_at_once():
+    """R8's schedule cut at 64 %: the ramp, the clip, the boost and the narrow sigma are as
+    without the cut until then, and the paper's objective from the cut on."""
+    cfg = replace(tracking_boost([0.0, 0.85], sigma_scale=0.2), deadline=0.85, only_positive=True)
+    cut = RewardCurriculum(replace(cfg, cut=0.64), total_iterations=100)
+    uncut = RewardCurriculum(cfg, total_iterations=100)
+    for it in range(64):
+        assert cut.update(it, 0.0) == uncut.update(it, 0.0)
+        assert cut.shaping == uncut.shaping and not cut.done
+    assert cut.end == 64 and uncut.end == 85
+    for it in (64, 70, 99):
+        cut.update(it, 0.0)
+        assert cut.done and cut.shaping == (1.0, False, {}, 1.0)
+
+
+def test_a_term_window_opening_at_the_cut_boosts_that_term_after_it():
+    """The G1 transition (reports/learning.md): the tracking boost ends at the cut, and the
+    fall's cost, x5 from the cut, falls linearly to the table's at 0.9."""
+    cfg = replace(
+        tracking_boost([0.0, 0.85], sigma_scale=0.2),
+        cut=0.6,
+        boost={"track_lin_vel_xy_exp": 3.0, "termination_penalty": 5.0},
+        boost_windows={"termination_penalty": [0.6, 0.9]},
+    )
+    cfg.check()
+    c = RewardCurriculum(cfg, total_iterations=100)
+    c.update(30, 0.0)
+    assert set(c.boosts) == {"track_lin_vel_xy_exp"} and c.sigma_scale < 1
+    c.update(60, 0.0)
+    assert c.boosts == {"termination_penalty": 5.0} and c.sigma_scale == 1.0
+    assert c.scale == 1.0 and not c.only_positive and not c.done
+    c.update(75, 0.0)
+    assert c.boosts["termination_penalty"] == pytest.approx(3.0)
+    c.update(90, 0.0)
+    assert c.done and c.shaping == (1.0, False, {}, 1.0)
+
+
+def test_a_term_window_needs_its_boost():
+    cfg = RewardCurriculumConfig(enabled=True, boost_windows={"termination_penalty": [0.6, 0.9]})
+    with pytest.raises(ValueError, match="boost_windows.termination_penalty"):
+        cfg.check()
+
+
+@pytest.mark.parametrize("value", [0.0, 1.2])
+def test_a_cut_must_be_a_fraction_of_the_run(value):
+    with pytest.raises(ValueError, match="cut"):
+        RewardCurriculumConfig(enabled=True, cut=value).check()
 
 
 def test_sigma_scale_must_be_positive():

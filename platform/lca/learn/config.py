@@ -115,6 +115,12 @@ class AlgoConfig:
     # iterations at the start that train the critic only (the actor frozen, the learning rate
     # fixed): a warm start's critic first learns the new run's returns. 0: none
     critic_warmup: int = 0
+    # from the reward curriculum's end (its cut or deadline: the table's weights, unclipped)
+    # PPO's learning rate is fixed at this (0: the schedule goes on), so the gait shaped
+    # before is changed slowly; the first `final_critic_warmup` iterations from there train
+    # the critic alone on the new returns
+    final_learning_rate: float = 0.0
+    final_critic_warmup: int = 0
 
     def check(self) -> None:
         def positive(key: str) -> None:
@@ -128,6 +134,8 @@ class AlgoConfig:
         for key in ("learning_rate", "clip_param", "max_grad_norm", "desired_kl"):
             positive(key)
         require(self.critic_warmup >= 0, "algo.critic_warmup", "must be >= 0")
+        require(self.final_critic_warmup >= 0, "algo.final_critic_warmup", "must be >= 0")
+        require(self.final_learning_rate >= 0, "algo.final_learning_rate", "must be >= 0")
         for key in ("num_steps_per_env", "num_learning_epochs", "num_mini_batches"):
             at_least_one(key)
         for key in ("entropy_coef", "value_loss_coef", "mirror_loss_coeff"):

@@ -5,7 +5,8 @@ return is to fall at once, or to stand still. Scaling the negative contributions
 configured terms (all by default) by `scale` < 1 lets tracking and the gait reward lead.
 The scale rises with the mean episode length or linearly with the iteration, never falls,
 and is exactly 1 from `deadline` x max_iterations on, so every run ends on the paper's
-objective.
+objective. A `cut` ends the ramp, the clip, the sigma and every open boost at once; a term's
+own boost window (`boost_windows`) may open there, e.g. to make a fall dear for a while.
 """
 
 from __future__ import annotations
@@ -24,16 +25,19 @@ class RewardCurriculum:
         self.cfg = cfg
         self.total = total_iterations
         self.deadline = math.ceil(cfg.deadline * total_iterations) if cfg.enabled else 0
+        self.cut = math.ceil(cfg.cut * total_iterations)
+        # the first iteration of the table's weights, unclipped (late boosts may follow)
+        self.end = min(self.deadline, self.cut)
         self.step = (1.0 - cfg.penalty_start) / max(cfg.ramp * total_iterations, 1.0)
         start = cfg.penalty_start if cfg.enabled else 1.0
         self.scale = float(start if scale is None else scale)
         self.iteration = 0
         # the iterations [start, end) of a late boost window; None: boosts follow the penalties
-        self.boost_window = (
-            tuple(math.ceil(f * total_iterations) for f in cfg.boost_window)
-            if cfg.boost_window
-            else None
-        )
+        self.boost_window = self._iterations(cfg.boost_window)
+        self.windows = {k: self._iterations(w) for k, w in cfg.boost_windows.items()}
+
+    def _iterations(self, window: list[float]) -> tuple[int, int] | None:
+        return tuple(math.ceil(f * self.total) for f in window) if window else None
 
     def target(self, iteration: int, episode_fraction: float) -> float:
         """Scale asked for by the mean episode length (fraction of the maximum) or, with
@@ -54,7 +58,7 @@ class RewardCurriculum:
         `by: tracking`, the tracking progress 1 - |u - v| / |u| of the last rollout."""
         c = self.cfg
         self.iteration = iteration
-        if not c.enabled or iteration >= self.deadline:
+        if not c.enabled or iteration >= self.end:
             self.scale = 1.0
         elif c.by == "tracking":
             if episode_fraction >= c.length_start and tracking >= c.gate:
@@ -93,34 +97,38 @@ class RewardCurriculum:
             and self.sigma_scale == 1.0
         )
 
-    def _boost_left(self) -> float:
-        """How much of the boosts' shaping is left: 1 at the start (of the window, if any),
-        falling to 0 once the penalties are the table's (at the window's end)."""
+    def _boost_left(self, window: tuple[int, int] | None) -> float:
+        """How much of a boost's shaping is left: 1 at the start (of its window, if any),
+        falling to 0 once the penalties are the table's (at the window's end); 0 from the
+        cut on for a window opened before it."""
+        it = self.iteration
         if not self.cfg.enabled:
             return 0.0
-        if self.boost_window:
-            start, end = self.boost_window
-            if not start <= self.iteration < end:
+        if window:
+            start, end = window
+            if not start <= it < end or start < self.cut <= it:
                 return 0.0
-            return 1.0 - (self.iteration - start) / max(end - start, 1)
+            return 1.0 - (it - start) / max(end - start, 1)
         if self.scale >= 1.0 and not self.only_positive:
             return 0.0
         return 1.0 - self.progress
 
     @property
     def boosts(self) -> dict[str, float]:
-        """Factors on the boosted terms' weights: the configured ones at the start (of the
-        window, if any), 1 (none left) once the penalties are the table's (at its end)."""
-        left = self._boost_left()
-        if not self.cfg.boost or left <= 0.0:
-            return {}
-        return {k: 1.0 + (float(f) - 1.0) * left for k, f in self.cfg.boost.items()}
+        """Factors on the boosted terms' weights: the configured ones at the start (of their
+        window, if any), none left once the penalties are the table's (at its end)."""
+        out = {}
+        for name, factor in self.cfg.boost.items():
+            left = self._boost_left(self.windows.get(name, self.boost_window))
+            if left > 0.0:
+                out[name] = 1.0 + (float(factor) - 1.0) * left
+        return out
 
     @property
     def sigma_scale(self) -> float:
         """Factor on the tracking kernels' sigma: the configured one at the start, 1 (the
         paper's) as the boosts end."""
-        return 1.0 + (float(self.cfg.sigma_scale) - 1.0) * self._boost_left()
+        return 1.0 + (float(self.cfg.sigma_scale) - 1.0) * self._boost_left(self.boost_window)
 
     @property
     def shaping(self) -> tuple[float, bool, dict[str, float], float]:

@@ -31,9 +31,15 @@ def build_train_cfg(cfg: DictConfig, run_name: str) -> dict:
     algo = OmegaConf.to_container(cfg.algo, resolve=True)
     algo.pop("name")
     num_steps = algo.pop("num_steps_per_env")
-    algo.pop("init_from")  # read by the trainer, not by PPO
-    algo.pop("critic_warmup")
-    algo.pop("init_map_zero")
+    # read by the trainer, not by PPO
+    for key in (
+        "init_from",
+        "init_map_zero",
+        "critic_warmup",
+        "final_learning_rate",
+        "final_critic_warmup",
+    ):
+        algo.pop(key)
     obs_normalization = algo.pop("obs_normalization")
     symmetry_cfg = None
     mirror_loss = algo.pop("mirror_loss_coeff")

@@ -119,17 +119,23 @@ class Trainer(Checkpoints):
     def perception_on(self, iteration: int) -> bool:
         return curriculum.perception_on(self.cfg.curriculum, iteration, self.total)
 
-    def _freeze_actor(self, frozen: bool) -> None:
-        """Critic warm-up: the actor's parameters out of the update and the learning rate
-        held (no KL to adapt it to); at the end the configured rate is set again."""
+    def _set_update(self, it: int) -> None:
+        """Critic warm-ups (after a warm start; after the reward curriculum ends): the
+        actor's parameters out of the update and the learning rate held (no KL to adapt it
+        to); at the end the configured rate is set again. From the curriculum's end (its
+        cut or deadline) with `final_learning_rate`, that rate, fixed."""
+        a, end = self.cfg.algo, self.rewards.end
+        frozen = it < a.critic_warmup or end <= it < end + a.final_critic_warmup
         actor = self.alg.actor
         was_frozen = not next(actor.parameters()).requires_grad
-        if frozen == was_frozen:
-            return
-        actor.requires_grad_(not frozen)
-        self.alg.schedule = "fixed" if frozen else self.cfg.algo.schedule
-        if not frozen:
-            set_learning_rate(self.alg, self.cfg.algo.learning_rate)
+        if frozen != was_frozen:
+            actor.requires_grad_(not frozen)
+            self.alg.schedule = "fixed" if frozen else a.schedule
+            if not frozen:
+                set_learning_rate(self.alg, a.learning_rate)
+        if a.final_learning_rate > 0 and it >= end:
+            self.alg.schedule = "fixed"
+            set_learning_rate(self.alg, a.final_learning_rate)
 
     def _curve_rows_before(self, iteration: int) -> list[dict]:
         """Curve rows of a resumed run up to its checkpoint (later rows are re-done)."""
@@ -252,7 +258,7 @@ class Trainer(Checkpoints):
             track_sums = np.array([float(v) for v in track_sums])
             torch.set_num_threads(update_threads)
             t1 = time.perf_counter()
-            self._freeze_actor(it < cfg.algo.critic_warmup)
+            self._set_update(it)
             losses = alg.update()
             t2 = time.perf_counter()
             self.runner.current_learning_iteration = it

@@ -98,6 +98,9 @@ class RewardCurriculumConfig:
     length_start: float = 0.2  # ramp starts at this mean episode length (fraction of the max)
     length_end: float = 0.8  # ... and reaches the paper's weights at this one
     deadline: float = 0.75  # fraction of max_iterations from which the weights are the paper's
+    # fraction of max_iterations at which the ramp, the clip, the sigma and every boost window
+    # open by then end at once (1: no cut); a window that opens at or after it still applies
+    cut: float = 1.0
     only_positive: bool = False  # legged_gym's clip of the step's sum at 0 while scale < 1
     # the length- or tracking-driven scale stops at `hold` (1: no hold); from `hold_until` x
     # max_iterations it rises linearly to 1 at the deadline, so a gait found under light
@@ -113,6 +116,9 @@ class RewardCurriculumConfig:
     # to 1 at `end` instead (e.g. [0.8, 0.9]: speed up a gait formed under the table's weights).
     # []: from the first iteration until the penalties are the table's
     boost_window: list[float] = field(default_factory=list)
+    # term -> its own [start, end] window instead of boost_window (e.g. {termination_penalty:
+    # [0.64, 0.9]} with cut 0.64: a fall costs more while the table's costs first arrive)
+    boost_windows: dict[str, list[float]] = field(default_factory=dict)
     # factor on the tracking kernels' sigma, on the boosts' schedule (back to 1 with them):
     # 0.2 makes standing still at a 0.45 m/s command earn 2 % of the velocity kernel instead
     # of the paper's 44 %, so a stall at a riser no longer pays nearly as well as a walk
@@ -131,6 +137,7 @@ class RewardCurriculumConfig:
             f"need 0 <= start < end <= 1, got {self.length_start}, {self.length_end}",
         )
         require(0 <= self.deadline <= 1, f"{key}.deadline", "must be in [0, 1]")
+        require(0 < self.cut <= 1, f"{key}.cut", f"must be in (0, 1], got {self.cut}")
         require(0 < self.ramp <= 1, f"{key}.ramp", "must be in (0, 1]")
         require(0 < self.hold <= 1, f"{key}.hold", "must be in (0, 1]")
         require(
@@ -143,13 +150,17 @@ class RewardCurriculumConfig:
         for part in ("terms", "unclipped"):
             for name in getattr(self, part):
                 REWARD_TERMS.check(name, f"{key}.{part}")
-        window = self.boost_window
-        require(
-            not window or (len(window) == 2 and 0 <= window[0] < window[1] < 1),
-            f"{key}.boost_window",
-            f"need [start, end] with 0 <= start < end < 1 (the run ends on the table's "
-            f"weights), got {list(window)}",
-        )
+        windows = {"boost_window": self.boost_window}
+        windows |= {f"boost_windows.{k}": w for k, w in self.boost_windows.items()}
+        for name, window in windows.items():
+            require(
+                not window or (len(window) == 2 and 0 <= window[0] < window[1] < 1),
+                f"{key}.{name}",
+                f"need [start, end] with 0 <= start < end < 1 (the run ends on the table's "
+                f"weights), got {list(window)}",
+            )
+        for name in self.boost_windows:
+            require(name in self.boost, f"{key}.boost_windows.{name}", "is not in boost")
         require(self.sigma_scale > 0, f"{key}.sigma_scale", f"must be > 0, got {self.sigma_scale}")
         for name, factor in self.boost.items():
             REWARD_TERMS.check(name, f"{key}.boost.{name}")
