@@ -130,12 +130,13 @@ class Trainer(Checkpoints):
         was_frozen = not next(actor.parameters()).requires_grad
         if frozen != was_frozen:
             actor.requires_grad_(not frozen)
-            self.alg.schedule = "fixed" if frozen else a.schedule
-            if not frozen:
-                set_learning_rate(self.alg, a.learning_rate)
         if a.final_learning_rate > 0 and it >= end:
             self.alg.schedule = "fixed"
             set_learning_rate(self.alg, a.final_learning_rate)
+        elif frozen != was_frozen:
+            self.alg.schedule = "fixed" if frozen else a.schedule
+            if not frozen:
+                set_learning_rate(self.alg, a.learning_rate)
 
     def _curve_rows_before(self, iteration: int) -> list[dict]:
         """Curve rows of a resumed run up to its checkpoint (later rows are re-done)."""
