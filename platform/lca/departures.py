@@ -24,7 +24,7 @@ BOOKKEEPING = {
     "sim.nconmax",
     "sim.njmax",
 }
-WHOLE = {"terrain.mixture"}  # compared as one value
+WHOLE = {"terrain.mixture", "terrain.practice"}  # compared as one value
 
 
 def departures(cfg: DictConfig) -> list[str]:

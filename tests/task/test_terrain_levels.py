@@ -57,7 +57,7 @@ def _row_of(env, ids) -> np.ndarray:
 def _place(env, row: int) -> np.ndarray:
     """Every env on `row`; returns their spawn points."""
     env.terrain_levels.level[:] = row
-    env.terrain_levels._place(np.arange(env.num_envs))
+    env.terrain_levels.place(np.arange(env.num_envs))
     return np.asarray(env.sim.env_origin).copy()
 
 

@@ -222,6 +222,8 @@ class Trainer(Checkpoints):
             env.commands.min_speed = self.commands.floor(it)
             if env.terrain_levels is not None:
                 env.terrain_levels.over = it >= cfg.terrain.levels_end * self.total
+            if env.terrain_practice is not None:
+                env.terrain_practice.set(it < cfg.terrain.practice_end * self.total)
             env.commands.ranges = self.commands.ranges(it, cfg.task.commands)
             ceiling = noise_ceiling(cfg.actor, it, self.total, self.rewards.progress)
             apply_ceiling(actor, ceiling)

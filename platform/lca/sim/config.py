@@ -139,6 +139,12 @@ class TerrainConfig:
     # fraction of the run from which the curriculum is over: every env resets onto the top
     # row, the configured difficulty itself (1.0: never, IsaacLab's way)
     levels_end: float = 1.0
+    # practice (not in the paper): until practice_end (a fraction of the run) the envs respawn
+    # on the tile kinds in these shares ({stairs_up: 0.5, ...}) instead of evenly over the
+    # grid; the terrain is unchanged, and from practice_end on the spread is even again.
+    # Set it with a leading +: `+terrain.practice={stairs_up: 0.5, flat: 0.5}`
+    practice: dict[str, float] = field(default_factory=dict)
+    practice_end: float = 0.0
     platform: float = 1.5  # m, flat square at each tile centre where the robot spawns
     num_steps: int = 8  # steps per pyramid side (stairs_up / stairs_down)
     block_size: float = 0.4  # m, side of a block of the uneven field
@@ -171,6 +177,7 @@ class TerrainConfig:
                 f"{value} m is not a multiple of terrain.resolution={self.resolution}",
             )
         require(self.platform < self.tile_size, "terrain.platform", "must be < tile_size")
+        self._check_practice()
         require(self.apron >= 0, "terrain.apron", f"must be >= 0, got {self.apron}")
         require(self.num_steps >= 1, "terrain.num_steps", f"must be >= 1, got {self.num_steps}")
         require(
@@ -187,6 +194,30 @@ class TerrainConfig:
             0 <= self.levels_end <= 1,
             "terrain.levels_end",
             f"must be a fraction of the run in [0, 1], got {self.levels_end}",
+        )
+
+    def _check_practice(self) -> None:
+        share = dict(self.practice)
+        if not share and self.practice_end == 0:
+            return
+        kinds = sorted(k for k, w in self.mixture.items() if w > 0)
+        for name in share:
+            require(
+                name in kinds,
+                f"terrain.practice.{name}",
+                f"not a tile kind of terrain.mixture; allowed: {kinds}",
+            )
+        weights = list(share.values()) or [0.0]
+        require(
+            min(weights) >= 0 and abs(sum(weights) - 1.0) < 1e-6,
+            "terrain.practice",
+            f"shares must be >= 0 and sum to 1, got {share}",
+        )
+        require(
+            0 < self.practice_end < 1,
+            "terrain.practice_end",
+            f"must be in (0, 1) with terrain.practice set (the run ends on the even spread), "
+            f"got {self.practice_end}",
         )
 
 

@@ -37,6 +37,7 @@ from lca.task.state import (
 from lca.task.step_metrics import step_metrics
 from lca.task.terminations import fell, non_finite
 from lca.task.terrain_levels import TerrainLevels
+from lca.task.terrain_practice import practice_for
 
 _W = mujoco.mjtWarning
 BAD_STATE_WARNINGS = [int(w) for w in (_W.mjWARN_BADQPOS, _W.mjWARN_BADQVEL, _W.mjWARN_BADQACC)]
@@ -134,6 +135,7 @@ class LocomotionEnv(VecEnv):
             self.terrain_levels = TerrainLevels(
                 self.sim, cfg.terrain, task.episode_length_s, self.rng
             )
+        self.terrain_practice = practice_for(self.sim, cfg.terrain, self.terrain_levels)
         self._reset_envs(self._all_ids())
         self._obs = self._observe(read_state(self.sim, self.contacts))
 

@@ -39,7 +39,7 @@ class TerrainLevels:
             xp.zeros(n, dtype=origin.dtype, device=device) for _ in range(3)
         )
         self.mark = xp.asarray(origin[:, :2], copy=True)  # where the path was last sampled
-        self._place(xp.arange(n, device=device))
+        self.place(xp.arange(n, device=device))
 
     def track(self, base_xy: Array, command_xy: Array, dt: float, sample_s: float = 1.0) -> None:
         """One env step of every env: the commanded distance grows by |command| dt, and the
@@ -72,7 +72,7 @@ class TerrainLevels:
         self.level[ids] = xp.where(level >= self.rows, restart, xp.clip(level, min=0))
         if self.over:
             self.level[ids] = self.rows - 1
-        self._place(ids)
+        self.place(ids)
 
     def mean(self) -> float:
         """The mean level as a fraction of the top row (0: all on row 0, 1: all on the top)."""
@@ -85,7 +85,7 @@ class TerrainLevels:
         u = draw(self.rng, 0.0, float(rows), n, self.centres)
         return self.xp.clip(self.xp.astype(self.xp.floor(u), self.xp.int64), max=rows - 1)
 
-    def _place(self, ids: Array) -> None:
+    def place(self, ids: Array) -> None:
         tile = self.level[ids] * self.cols + self.column[ids]
         self.sim.env_origin[ids] = self.centres[tile]
         self.mark[ids] = self.centres[tile][:, :2]
