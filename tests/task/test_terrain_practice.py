@@ -7,6 +7,7 @@ import pytest
 
 from lca.config import compose
 from lca.config.errors import ConfigValueError
+from lca.evaluate.protocol import trial_config
 from lca.task.terrain_practice import spread
 
 KINDS = ["stairs_down", "flat", "stairs_up", "uneven", "stairs_up", "flat"]
@@ -75,3 +76,9 @@ def test_env_spawns_by_shares_until_switched_off(make_env, levels):
         env.terrain_levels.place(np.arange(env.num_envs))  # what a reset does
     kinds = _kinds_at_spawn(env)
     assert {k: kinds.count(k) for k in set(kinds)} == dict.fromkeys(PITS, 4)
+
+
+def test_evaluation_spreads_units_evenly():
+    cfg = compose(["terrain=mixed", ALL_PITS, f"{END}=0.5"])
+    trial = trial_config(cfg, 4, 5.0, [0.3, 0.6])
+    assert dict(trial.terrain.practice) == {} and trial.terrain.practice_end == 0.0

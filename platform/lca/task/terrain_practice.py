@@ -29,6 +29,8 @@ def spread(kinds: list[str], n: int, share: dict[str, float] | None = None) -> n
     for i in np.argsort(-(exact - counts), kind="stable")[: n - counts.sum()]:
         counts[i] += 1
     tiles = {k: [i for i, kind in enumerate(kinds) if kind == k] for k in names}
+    if missing := sorted(k for k in names if not tiles[k]):
+        raise ValueError(f"terrain.practice: no tile of {missing} in the grid {sorted(set(kinds))}")
     dealt = [
         (j / count, tiles[k][j % len(tiles[k])])
         for k, count in zip(names, counts, strict=True)
