@@ -122,16 +122,22 @@ class Terrain:
         return self._flat[key]
 
 
+def apportion(weights: list[float], n: int) -> np.ndarray:
+    """`n` items split in proportion to `weights` by largest remainder (ties in order)."""
+    w = np.asarray(weights, float)
+    exact = w / w.sum() * n
+    counts = np.floor(exact).astype(int)
+    for i in np.argsort(-(exact - counts), kind="stable")[: n - counts.sum()]:
+        counts[i] += 1
+    return counts
+
+
 def tile_kinds(cfg: TerrainConfig, rng: np.random.Generator, n: int | None = None) -> list[str]:
     """`n` tile types (default: the whole grid) in proportion to the mixture weights (largest
     remainder, ties in registration order), shuffled."""
     n = cfg.rows * cfg.cols if n is None else n
     names = TILES.names()
-    weights = np.array([float(cfg.mixture.get(t, 0.0)) for t in names], float)
-    exact = weights / weights.sum() * n
-    counts = np.floor(exact).astype(int)
-    for i in np.argsort(-(exact - counts), kind="stable")[: n - counts.sum()]:
-        counts[i] += 1
+    counts = apportion([float(cfg.mixture.get(t, 0.0)) for t in names], n)
     kinds = [t for t, k in zip(names, counts, strict=True) for _ in range(k)]
     return [kinds[i] for i in rng.permutation(n)]
 

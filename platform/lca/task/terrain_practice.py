@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from lca.arrays import device_of, like, namespace
+from lca.sim.terrain import apportion
 
 
 def spread(kinds: list[str], n: int, share: dict[str, float] | None = None) -> np.ndarray:
@@ -24,10 +25,7 @@ def spread(kinds: list[str], n: int, share: dict[str, float] | None = None) -> n
     if share is None:
         return np.arange(n) % len(kinds)
     names = [k for k, w in share.items() if w > 0]
-    exact = np.array([share[k] for k in names], float) / sum(share[k] for k in names) * n
-    counts = np.floor(exact).astype(int)
-    for i in np.argsort(-(exact - counts), kind="stable")[: n - counts.sum()]:
-        counts[i] += 1
+    counts = apportion([share[k] for k in names], n)
     tiles = {k: [i for i, kind in enumerate(kinds) if kind == k] for k in names}
     if missing := sorted(k for k in names if not tiles[k]):
         raise ValueError(f"terrain.practice: no tile of {missing} in the grid {sorted(set(kinds))}")
