@@ -44,10 +44,9 @@ class TerrainPractice:
     def __init__(self, sim, terrain_cfg, terrain_levels=None) -> None:
         self.sim, self.levels = sim, terrain_levels
         self.share = {k: float(v) for k, v in terrain_cfg.practice.items()}
-        tiles = sim.scene.terrain.tiles
+        kinds = [t.kind for t in sim.scene.terrain.tiles]
         # a levelled grid keeps one kind per column: the practice deals columns
-        self.kinds = [t.kind for t in tiles][: int(terrain_cfg.cols)] if terrain_levels else []
-        self.kinds = self.kinds or [t.kind for t in tiles]
+        self.kinds = kinds[: int(terrain_cfg.cols)] if terrain_levels is not None else kinds
         self.centres = sim.scene.terrain.tile_centres()
         self.on = False
 
