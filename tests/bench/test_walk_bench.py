@@ -122,3 +122,47 @@ def test_a_terrain_runs_figure_plots_its_stairs_and_uneven_probes(tmp_path, monk
     figures.clear()
     walk.plot(flat, tmp_path / "flat.png")
     assert "stairs-medium" not in {line.get_label() for line in figures[0].axes[0].get_lines()}
+
+
+@pytest.mark.parametrize("confirm_units, agrees", [(3, True), (3, False), (0, True)])
+def test_a_walking_probe_is_confirmed_by_a_larger_evaluation(
+    tmp_path, monkeypatch, confirm_units, agrees
+):
+    def probes_walk(row: dict) -> bool:  # the 2-unit probe "walks"; the larger one: `agrees`
+        return row["units"] == 2 or agrees
+
+    monkeypatch.setattr(walk, "walks", probes_walk)
+    out = walk.run(
+        [
+            *SMOKE,
+            f"run={tmp_path / 'run'}",
+            f"figure={tmp_path / 'walk.png'}",
+            "iterations=2",
+            "eval_every_s=0",
+            "eval_from=2",
+            "eval.units=2",
+            "eval.steps=20",
+            f"confirm_units={confirm_units}",
+        ],
+        log=None,
+    )
+    probes = pd.read_csv(tmp_path / "run" / "probe_evals.csv")
+    if confirm_units:
+        # the probe's row, then the confirmation's: same iteration, more units
+        assert list(probes["iteration"]) == [1, 1]
+        assert list(probes["units"]) == [2, 3] and list(probes["confirm"]) == [0, 1]
+    else:
+        assert list(probes["units"]) == [2] and list(probes["confirm"]) == [0]
+    assert out["walked"] is agrees
+    assert out["iterations_to_walk"] == (2 if agrees else None)
+    assert out["probe"]["confirm_units"] == confirm_units
+    assert (tmp_path / "walk.png").stat().st_size > 0
+
+
+def test_an_unconfirmed_probe_does_not_walk():
+    row = {"success": 100.0, "track_cm_s": 10.0, "still_cm_s": 3.0, "paper_objective": 1}
+    row |= {"penalty_scale": 1.0, "units": 64, "confirm": 0}
+    assert walk.walks(row) and not walk.counts(row, 256)
+    assert walk.counts({**row, "units": 256, "confirm": 1}, 256)
+    assert walk.counts(row, 0)  # no confirmation asked for
+    assert not walk.counts({**row, "confirm": 1, "track_cm_s": 30.0}, 256)

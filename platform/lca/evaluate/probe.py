@@ -37,6 +37,8 @@ PROBE_FIELDS = (
     "contacts_per_step",
     "mean_steps",
     "eval_s",
+    "units",
+    "confirm",  # 1: a larger evaluation confirming the probe of the same iteration
 )
 
 
@@ -64,6 +66,7 @@ class TrainingProbe:
         self.policy = new_policy(cfg, self.env, train_cfg)
         self.seed = int(cfg.eval.seed)
         self.steps = int(steps)
+        self.units = int(units)
         self.out = Path(out) if out is not None else None
 
     @staticmethod
@@ -91,6 +94,7 @@ class TrainingProbe:
             "contacts_per_step": float(np.mean(result["contacts_per_step"])),
             "mean_steps": float(np.mean(result["steps"])),
             "eval_s": round(time.perf_counter() - t0, 2),
+            "units": self.units,
         }
 
     def record(self, row: dict) -> None:
