@@ -81,6 +81,9 @@ class Checkpoints:
         if state is None:  # a shipped checkpoint, or one from before exact resume
             print(f"[lca] {path.name} holds no loop state: the environment starts afresh")
             return
+        # the state is of the env that trained the saved iteration: past the terrain's rebuild,
+        # the full grid (a rebuild due at `start` itself happens in the loop, as it did)
+        self._match_terrain(self.start - 1)
         restore_env_state(self.env, state["env"])
         self.stats.load_state_dict(state["stats"])
         torch.set_rng_state(state["torch_rng"].cpu())

@@ -9,6 +9,7 @@ tensorboard / wandb through rsl-rl's own logger.
 from __future__ import annotations
 
 import contextlib
+import copy
 import csv
 import io
 import math
@@ -116,6 +117,30 @@ class Trainer(Checkpoints):
         self.commands = CommandCurriculum(cfg.task.command_curriculum, self.total)
         self.stopped_early = False
 
+    def full_grid_from(self, iteration: int) -> bool:
+        """True where `terrain.after_levels: full_grid` trains on the grid without levels."""
+        t = self.cfg.terrain
+        end = math.ceil(t.levels_end * self.total)
+        return bool(t.levels) and t.after_levels == "full_grid" and iteration >= end
+
+    def _match_terrain(self, iteration: int) -> bool:
+        """Rebuild the env on the grid without levels once the terrain curriculum is over
+        (`terrain.after_levels: full_grid`); True if it was rebuilt. Every episode restarts
+        there: a new terrain is a new model."""
+        if not self.full_grid_from(iteration) or self.env.terrain_levels is None:
+            return False
+        cfg = copy.deepcopy(self.cfg)
+        cfg.terrain.levels = False
+        with torch.random.fork_rng(devices=[]):  # the training's stream is the run's own
+            self.env = LocomotionEnv(cfg)
+        self.env.set_perception(self.perception_on(iteration))
+        self.runner.env = self.env
+        if self.alg.symmetry:  # rsl-rl hands the env to the mirror functions
+            self.alg.symmetry.env = self.env
+        self.stats = EpisodeStats(self.env.num_envs, self.env.device)
+        print(f"[lca] it {iteration}: the terrain curriculum is over; training on the full grid")
+        return True
+
     def perception_on(self, iteration: int) -> bool:
         return curriculum.perception_on(self.cfg.curriculum, iteration, self.total)
 
@@ -212,6 +237,9 @@ class Trainer(Checkpoints):
         for it in range(self.start, self.total):
             if it == switch and it > 0 and not self.perception_on(it - 1):
                 self.save(f"stage1_blind_it{it - 1}.pt", it - 1, upload=True)
+            if self._match_terrain(it):
+                env, stats = self.env, self.stats
+                obs = env.get_observations().to(self.device)
             if self.perception_on(it) != env.perception:
                 env.set_perception(self.perception_on(it))
                 obs = env.get_observations().to(self.device)

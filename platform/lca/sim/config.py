@@ -11,6 +11,8 @@ from lca.config.errors import check_range, require
 from lca.config.registry import TILES
 from lca.config.schema import group
 
+AFTER_LEVELS = ("top_row", "full_grid")  # terrain.after_levels
+
 
 @group("sim")
 @dataclass
@@ -139,6 +141,10 @@ class TerrainConfig:
     # fraction of the run from which the curriculum is over: every env resets onto the top
     # row, the configured difficulty itself (1.0: never, IsaacLab's way)
     levels_end: float = 1.0
+    # what follows the curriculum: top_row (every env on the levelled grid's top row, one
+    # tile of each kind) or full_grid (the terrain rebuilt once as the grid without levels:
+    # every tile at the difficulty, kinds by the mixture, as evaluation draws it)
+    after_levels: str = "top_row"
     # practice (not in the paper): until practice_end (a fraction of the run) the envs respawn
     # on the tile kinds in these shares ({stairs_up: 0.5, ...}) instead of evenly over the
     # grid; the terrain is unchanged, and from practice_end on the spread is even again.
@@ -194,6 +200,11 @@ class TerrainConfig:
             0 <= self.levels_end <= 1,
             "terrain.levels_end",
             f"must be a fraction of the run in [0, 1], got {self.levels_end}",
+        )
+        require(
+            self.after_levels in AFTER_LEVELS,
+            "terrain.after_levels",
+            f"unknown '{self.after_levels}'; allowed: {AFTER_LEVELS}",
         )
 
     def _check_practice(self) -> None:
