@@ -14,16 +14,20 @@ from .helpers import make_trainer, read_curve, smoke_cfg
 
 
 @pytest.mark.slow  # trains: see README
-def test_practice_ends_at_its_fraction_of_the_run(tmp_path, smoke_scene) -> None:
+@pytest.mark.parametrize("start, practised", [(0.0, [1, 1, 0, 0]), (0.25, [0, 1, 0, 0])])
+def test_practice_holds_between_its_fractions_of_the_run(
+    tmp_path, smoke_scene, start, practised
+) -> None:
     cfg = smoke_cfg(
         "scale.max_iterations=4",
         "+terrain.practice={stairs_up: 0.5, uneven: 0.5}",
+        f"terrain.practice_start={start}",
         "terrain.practice_end=0.5",
     )
     trainer = make_trainer(cfg, tmp_path / "run", smoke_scene)
     on = []
     trainer.train(hook=lambda t, it, row: on.append(t.env.terrain_practice.on))
-    assert on == [True, True, False, False]
+    assert on == [bool(p) for p in practised]
     centres = smoke_scene.terrain.tile_centres()
     spread = centres[np.arange(trainer.env.num_envs) % len(centres)]
     np.testing.assert_allclose(np.asarray(trainer.env.sim.env_origin), spread)

@@ -44,6 +44,7 @@ def test_a_kind_with_no_share_gets_no_env():
         ([ALL_PITS], END),
         ([ALL_PITS, f"{END}=1.0"], END),
         (["terrain.practice_end=0.5"], "terrain.practice"),
+        ([ALL_PITS, f"{END}=0.5", "terrain.practice_start=0.5"], "terrain.practice_start"),
     ],
 )
 def test_bad_practice_names_its_key(overrides, key):

@@ -54,6 +54,7 @@ def trial_config(
     c.task.randomization.enabled = False
     c.terrain.levels = False  # a test is its difficulty on every tile, no curriculum
     c.terrain.practice, c.terrain.practice_end = {}, 0.0  # and the units spread evenly
+    c.terrain.practice_start = 0.0
     commands = c.task.commands
     commands.lin_vel_x = list(forward)
     commands.lin_vel_y = [0.0, 0.0]

@@ -251,7 +251,9 @@ class Trainer(Checkpoints):
             if env.terrain_levels is not None:
                 env.terrain_levels.over = it >= cfg.terrain.levels_end * self.total
             if env.terrain_practice is not None:
-                env.terrain_practice.set(it < cfg.terrain.practice_end * self.total)
+                t = cfg.terrain
+                on = t.practice_start * self.total <= it < t.practice_end * self.total
+                env.terrain_practice.set(on)
             env.commands.ranges = self.commands.ranges(it, cfg.task.commands)
             ceiling = noise_ceiling(cfg.actor, it, self.total, self.rewards.progress)
             apply_ceiling(actor, ceiling)

@@ -150,6 +150,7 @@ class TerrainConfig:
     # grid; the terrain is unchanged, and from practice_end on the spread is even again.
     # Set it with a leading +: `+terrain.practice={stairs_up: 0.5, flat: 0.5}`
     practice: dict[str, float] = field(default_factory=dict)
+    practice_start: float = 0.0  # from here (e.g. after a levelled start) until practice_end
     practice_end: float = 0.0
     platform: float = 1.5  # m, flat square at each tile centre where the robot spawns
     num_steps: int = 8  # steps per pyramid side (stairs_up / stairs_down)
@@ -229,6 +230,11 @@ class TerrainConfig:
             "terrain.practice_end",
             f"must be in (0, 1) with terrain.practice set (the run ends on the even spread), "
             f"got {self.practice_end}",
+        )
+        require(
+            0 <= self.practice_start < self.practice_end,
+            "terrain.practice_start",
+            f"must be in [0, practice_end = {self.practice_end}), got {self.practice_start}",
         )
 
 
