@@ -14,6 +14,21 @@ from lca.store import RunDir
 pytestmark = pytest.mark.slow  # trains, evaluates or runs a stage: see README
 
 
+def two_iterations(tmp_path, *extra: str) -> list[str]:
+    """A 2-iteration smoke walk probed once, at its last iteration, with 2 units."""
+    return [
+        *SMOKE,
+        *extra,
+        f"run={tmp_path / 'run'}",
+        f"figure={tmp_path / 'walk.png'}",
+        "iterations=2",
+        "eval_every_s=0",
+        "eval_from=2",
+        "eval.units=2",
+        "eval.steps=20",
+    ]
+
+
 def test_until_stops_a_probed_run_that_is_complete(tmp_path):
     out = walk.run(
         [
@@ -66,20 +81,7 @@ def test_walking_on_terrain_needs_stairs_and_uneven():
 
 
 def test_a_run_on_terrain_is_probed_on_stairs_and_uneven(tmp_path, monkeypatch):
-    out = walk.run(
-        [
-            *SMOKE,
-            "terrain=mixed",
-            f"run={tmp_path / 'run'}",
-            f"figure={tmp_path / 'walk.png'}",
-            "iterations=2",
-            "eval_every_s=0",
-            "eval_from=2",
-            "eval.units=2",
-            "eval.steps=20",
-        ],
-        log=None,
-    )
+    out = walk.run(two_iterations(tmp_path, "terrain=mixed"), log=None)
     probes = pd.read_csv(tmp_path / "run" / "probe_evals.csv")
     assert list(probes["iteration"]) == [1]
     for key in ("stairs_success", "uneven_success"):
@@ -132,20 +134,7 @@ def test_a_walking_probe_is_confirmed_by_a_larger_evaluation(
         return row["units"] == 2 or agrees
 
     monkeypatch.setattr(walk, "walks", probes_walk)
-    out = walk.run(
-        [
-            *SMOKE,
-            f"run={tmp_path / 'run'}",
-            f"figure={tmp_path / 'walk.png'}",
-            "iterations=2",
-            "eval_every_s=0",
-            "eval_from=2",
-            "eval.units=2",
-            "eval.steps=20",
-            f"confirm_units={confirm_units}",
-        ],
-        log=None,
-    )
+    out = walk.run(two_iterations(tmp_path, f"confirm_units={confirm_units}"), log=None)
     probes = pd.read_csv(tmp_path / "run" / "probe_evals.csv")
     if confirm_units:
         # the probe's row, then the confirmation's: same iteration, more units
