@@ -141,9 +141,9 @@ def run(args: list[str], log: Callable[[str], None] | None = print) -> dict:
     train_cfg = build_train_cfg(cfg, run.path.name)
     out = run.path / "probe_evals.csv"
     probes = Probes(cfg, out, train_cfg, cfg.eval.units)
-    confirm: list[Probes] = []  # built at the first walking probe only
     trainer = Trainer(cfg, run)
-    state = {"next": 0.0, "walked": None}
+    # the confirmation's probes are built at the first walking probe only
+    state = {"next": 0.0, "walked": None, "confirm": None}
     confirm_units = int(opts["confirm_units"])
     for row in TrainingProbe.read(out):  # a resumed benchmark keeps its earlier evaluations
         state["next"] = row["train_wall_s"] + opts["eval_every_s"]
@@ -166,14 +166,15 @@ def run(args: list[str], log: Callable[[str], None] | None = print) -> dict:
             "confirm": 0,
         }
         entry |= probes.evaluate(trainer.alg.get_policy())
-        probes.record(entry, log, row["penalty_scale"])
+        probes.record(entry, log)
         trainer.save(f"probe_it{it}.pt", it)  # each evaluated policy, to look at or resume
         if walks(entry) and state["walked"] is None and confirm_units > 0:
-            if not confirm:  # its networks' init must not draw from the training's stream
+            if state["confirm"] is None:  # its networks' init: not from the training's stream
                 with torch.random.fork_rng(devices=[]):
-                    confirm.append(Probes(cfg, out, train_cfg, confirm_units))
-            entry = {**entry, **confirm[0].evaluate(trainer.alg.get_policy()), "confirm": 1}
-            confirm[0].record(entry, log, row["penalty_scale"])
+                    state["confirm"] = Probes(cfg, out, train_cfg, confirm_units)
+            confirm = state["confirm"]
+            entry = {**entry, **confirm.evaluate(trainer.alg.get_policy()), "confirm": 1}
+            confirm.record(entry, log)
         if counts(entry, confirm_units) and state["walked"] is None:
             state["walked"] = entry
         return last or (state["walked"] is not None and opts["stop"] == "true")
@@ -219,17 +220,17 @@ class Probes:
             result["eval_s"] += on_terrain["eval_s"]
         return result
 
-    def record(self, entry: dict, log: Callable[[str], None] | None, penalties: float) -> None:
+    def record(self, entry: dict, log: Callable[[str], None] | None) -> None:
         self.forward.record(entry)
         if log:
-            what = f"confirm x{entry['units']}" if entry.get("confirm") else ""
+            what = f"confirm x{entry['units']} | " if entry.get("confirm") else ""
             log(
                 f"[walk] {entry['train_wall_s'] / 60:6.1f} min "
                 f"{entry['env_steps'] / 1e6:6.2f} M steps | {what}success "
                 f"{entry['success']:5.1f} % | track {entry['track_cm_s']:5.1f} cm/s | "
                 f"still {entry['still_cm_s']:5.1f} cm/s | "
                 + "".join(f"{k.split('_')[0]} {entry[k]:5.1f} % | " for k in self.terrain)
-                + f"penalties x{penalties:.2f} | eval {entry['eval_s']:.0f} s"
+                + f"penalties x{entry['penalty_scale']:.2f} | eval {entry['eval_s']:.0f} s"
             )
 
 

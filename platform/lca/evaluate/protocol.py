@@ -53,8 +53,8 @@ def trial_config(
     c.task.episode_length_s = episode_s
     c.task.randomization.enabled = False
     c.terrain.levels = False  # a test is its difficulty on every tile, no curriculum
-    c.terrain.practice, c.terrain.practice_end = {}, 0.0  # and the units spread evenly
-    c.terrain.practice_start = 0.0
+    # and the units spread evenly
+    c.terrain.practice, c.terrain.practice_start, c.terrain.practice_end = {}, 0.0, 0.0
     commands = c.task.commands
     commands.lin_vel_x = list(forward)
     commands.lin_vel_y = [0.0, 0.0]

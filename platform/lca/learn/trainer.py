@@ -117,11 +117,14 @@ class Trainer(Checkpoints):
         self.commands = CommandCurriculum(cfg.task.command_curriculum, self.total)
         self.stopped_early = False
 
+    def levels_over(self, iteration: int) -> bool:
+        """True from `terrain.levels_end` on, where the terrain-level curriculum is over."""
+        return iteration >= self.cfg.terrain.levels_end * self.total
+
     def full_grid_from(self, iteration: int) -> bool:
         """True where `terrain.after_levels: full_grid` trains on the grid without levels."""
         t = self.cfg.terrain
-        end = math.ceil(t.levels_end * self.total)
-        return bool(t.levels) and t.after_levels == "full_grid" and iteration >= end
+        return bool(t.levels) and t.after_levels == "full_grid" and self.levels_over(iteration)
 
     def _match_terrain(self, iteration: int) -> bool:
         """Rebuild the env on the grid without levels once the terrain curriculum is over
@@ -249,7 +252,7 @@ class Trainer(Checkpoints):
             env.reward_manager.set_shaping(*self.rewards.shaping)
             env.commands.min_speed = self.commands.floor(it)
             if env.terrain_levels is not None:
-                env.terrain_levels.over = it >= cfg.terrain.levels_end * self.total
+                env.terrain_levels.over = self.levels_over(it)
             if env.terrain_practice is not None:
                 t = cfg.terrain
                 on = t.practice_start * self.total <= it < t.practice_end * self.total
