@@ -113,3 +113,79 @@ def test_map_zero_start_refuses_a_recurrent_actor() -> None:
 
     with pytest.raises(ValueError, match="recurrent actor"):
         zero_map_state({}, SimpleNamespace(is_recurrent=True), "elu")
+
+
+def test_widen_history_inserts_silent_older_frames() -> None:
+    from lca.learn.warm_start import widen_history
+
+    frame, current, hidden = 3, 2, 4
+    stats = torch.arange(2 * frame + current, dtype=torch.float32)[None]  # 2 frames, then current
+    weight = torch.randn(hidden, 2 * frame + current + 5)  # 5: an encoder's features
+    source = {
+        "obs_normalizer._mean": stats,
+        "obs_normalizer._var": stats + 100,
+        "obs_normalizer._std": stats + 200,
+        "obs_normalizer.count": torch.tensor(7),
+        "mlp.0.weight": weight,
+        "mlp.0.bias": torch.ones(hidden),
+    }
+    state = widen_history(source, obs_dim=4 * frame + current, frame_dim=frame, frames=4)
+    mean = state["obs_normalizer._mean"][0].tolist()
+    assert mean == [0, 1, 2, 3, 4, 5, 0, 1, 2, 0, 1, 2, 6, 7]  # the newest frame's statistics
+    assert state["obs_normalizer._std"][0, 6:9].tolist() == [200, 201, 202]
+    widened = state["mlp.0.weight"]
+    assert widened.shape == (hidden, 4 * frame + current + 5)
+    torch.testing.assert_close(widened[:, : 2 * frame], weight[:, : 2 * frame])
+    assert torch.all(widened[:, 2 * frame : 4 * frame] == 0)
+    torch.testing.assert_close(widened[:, 4 * frame :], weight[:, 2 * frame :])
+    assert state["obs_normalizer.count"] == 7 and state["mlp.0.bias"] is source["mlp.0.bias"]
+    with pytest.raises(ValueError, match="task.observations.history=4"):
+        widen_history(source, obs_dim=4 * frame + current + 1, frame_dim=frame, frames=4)
+    with pytest.raises(ValueError, match="obs_normalizer"):
+        widen_history({"mlp.0.weight": weight}, obs_dim=10, frame_dim=frame, frames=4)
+
+
+@pytest.mark.slow  # trains: see README
+def test_a_shorter_history_starts_a_longer_one_acting_the_same(tmp_path, smoke_scene) -> None:
+    donor = make_trainer(
+        smoke_cfg("scale.max_iterations=2", "policy=blind", "task.observations.history=2"),
+        tmp_path / "donor",
+        smoke_scene,
+    )
+    donor.train()
+    source = tmp_path / "donor" / "checkpoints" / "latest.pt"
+    cfg = smoke_cfg(
+        "policy=blind",
+        "task.observations.history=4",
+        f"algo.init_from={source}",
+        "algo.init_widen_history=true",
+    )
+    warm = make_trainer(cfg, tmp_path / "warm", smoke_scene)
+    frame = warm.env.history.buffer.shape[2]
+    obs = warm.env.get_observations()
+    seen = obs.clone()
+    seen["policy"] = torch.randn_like(obs["policy"])
+    seen["critic"] = torch.randn_like(obs["critic"])
+    short = seen.clone(recurse=False)
+    for group in ("policy", "critic"):  # the donor's view: its two newest frames, then the rest
+        short[group] = torch.cat([seen[group][:, : 2 * frame], seen[group][:, 4 * frame :]], 1)
+    with torch.no_grad():
+        torch.testing.assert_close(
+            warm.alg.actor(seen, stochastic_output=False),
+            donor.alg.actor(short, stochastic_output=False),
+        )
+        torch.testing.assert_close(warm.alg.critic(seen), donor.alg.critic(short))
+    warm.train()  # the widened networks train
+
+
+def test_a_different_history_without_widening_fails_to_load(tmp_path, smoke_scene) -> None:
+    donor = make_trainer(
+        smoke_cfg("scale.max_iterations=1", "task.observations.history=2"),
+        tmp_path / "donor",
+        smoke_scene,
+    )
+    donor.save("latest.pt", 0)
+    source = tmp_path / "donor" / "checkpoints" / "latest.pt"
+    cfg = smoke_cfg("task.observations.history=3", f"algo.init_from={source}")
+    with pytest.raises(RuntimeError, match="size mismatch"):
+        make_trainer(cfg, tmp_path / "warm", smoke_scene)

@@ -13,7 +13,7 @@ from pathlib import Path
 import torch
 
 from lca.learn import curriculum
-from lca.learn.warm_start import zero_map_state
+from lca.learn.warm_start import widen_history, zero_map_state
 from lca.paths import root
 from lca.store import write_atomically
 from lca.task.env_state import env_state, restore_env_state
@@ -99,21 +99,33 @@ class Checkpoints:
             path = root() / path
         if not path.is_file():
             raise FileNotFoundError(f"algo.init_from: no checkpoint at {path}")
-        if not self.cfg.algo.init_map_zero:
+        algo = self.cfg.algo
+        if not algo.init_map_zero and not algo.init_widen_history:
             self.runner.load(
                 str(path), load_cfg={"actor": True, "critic": True}, map_location=self.device
             )
             print(f"[lca] {self.run.path.name} starts from the networks of {path}")
             return
         saved = torch.load(path, map_location=self.device, weights_only=False)
+        frames, frame_dim = self.env.history.buffer.shape[1:]
         for name in ("actor", "critic"):
             model = getattr(self.alg, name)
             source = saved[f"{name}_state_dict"]
-            model.load_state_dict(zero_map_state(source, model, self.cfg.actor.activation))
-        print(
-            f"[lca] {self.run.path.name} starts from the networks of {path}, "
-            "its map's contribution zero"
-        )
+            if algo.init_widen_history:
+                obs_dim = model.obs_normalizer._mean.shape[-1]
+                source = widen_history(source, obs_dim, frame_dim, frames)
+            if algo.init_map_zero:
+                source = zero_map_state(source, model, self.cfg.actor.activation)
+            model.load_state_dict(source)
+        how = [
+            what
+            for what, on in (
+                ("its map's contribution zero", algo.init_map_zero),
+                (f"its history widened to {frames} frames", algo.init_widen_history),
+            )
+            if on
+        ]
+        print(f"[lca] {self.run.path.name} starts from the networks of {path}, {', '.join(how)}")
 
     def _load_newest_readable(self) -> dict | None:
         """Load the newest checkpoint that reads (latest, then previous), saying what was

@@ -112,6 +112,10 @@ class AlgoConfig:
     # MLP-encoder source's zero-map features folded into the first layer's bias, their weights
     # zero, the encoder fresh; any encoder (mlp, cnn) can start so. false: a strict load
     init_map_zero: bool = False
+    # with init_from: a source trained with a shorter task.observations.history starts this
+    # run's longer one (lca.learn.warm_start): the older frames' weights zero, so it acts as
+    # the source at first. false: the history lengths must match
+    init_widen_history: bool = False
     # iterations at the start that train the critic only (the actor frozen, the learning rate
     # fixed): a warm start's critic first learns the new run's returns. 0: none
     critic_warmup: int = 0

@@ -35,6 +35,7 @@ def build_train_cfg(cfg: DictConfig, run_name: str) -> dict:
     for key in (
         "init_from",
         "init_map_zero",
+        "init_widen_history",
         "critic_warmup",
         "final_learning_rate",
         "final_critic_warmup",

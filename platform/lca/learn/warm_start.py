@@ -1,4 +1,6 @@
-"""A warm start whose map contributes nothing at first (`algo.init_map_zero`).
+"""Warm starts that change the network's inputs but not, at first, its outputs.
+
+`algo.init_map_zero`: a map that contributes nothing at first.
 
 Issue 28's common start: every policy of the reference set, whatever its encoder, starts from
 the networks of one blind walker. A blind policy's encoder only ever saw the zero map, so it
@@ -6,6 +8,10 @@ is one constant vector z0 to the first layer after it. The transplant folds W_z 
 layer's bias and zeroes W_z: the new network computes exactly the source's actions and values
 (on a zero map) while its own encoder, freshly initialised, starts with no say. The columns W_z
 get gradients from the first update, and through them the encoder.
+
+`algo.init_widen_history`: a source trained with a shorter proprioception history starts a run
+with a longer one. The frames it never saw get zero weights (the same actions and values at
+first) and its normaliser's statistics of the newest frame, so the gradient can give them a say.
 """
 
 from __future__ import annotations
@@ -92,4 +98,42 @@ def zero_map_state(
             )
         else:
             state[key] = source[key].clone()
+    return state
+
+
+NORMALISER = ("obs_normalizer._mean", "obs_normalizer._var", "obs_normalizer._std")
+
+
+def widen_history(
+    source: dict[str, torch.Tensor], obs_dim: int, frame_dim: int, frames: int
+) -> dict[str, torch.Tensor]:
+    """`source` (a model's state dict whose flat observation starts with its history, newest
+    frame first) as if its history held `frames` frames of `frame_dim` values and its flat
+    observation were `obs_dim` wide: older frames inserted after its own, with zero weights in
+    the first layer and the newest frame's normaliser statistics. Raises naming the key when
+    the widths do not fit a shorter history."""
+    weight_key = f"{FIRST_LAYER}.weight"
+    if NORMALISER[0] not in source or weight_key not in source:
+        raise ValueError(
+            f"algo.init_widen_history: the source has no '{NORMALISER[0]}' or '{weight_key}': "
+            "it needs an MLP model with an observation normaliser"
+        )
+    extra = obs_dim - source[NORMALISER[0]].shape[-1]
+    own = frames - extra // frame_dim if frame_dim > 0 else 0
+    if extra < 0 or frame_dim <= 0 or extra % frame_dim or own < 1:
+        raise ValueError(
+            f"algo.init_widen_history: the source's observation is "
+            f"{source[NORMALISER[0]].shape[-1]} wide and this run's {obs_dim}: not a shorter "
+            f"history of {frame_dim}-value frames (task.observations.history={frames})"
+        )
+    cut = own * frame_dim
+    state = dict(source)
+    for key in NORMALISER:
+        stats = source[key]
+        newest = stats[..., :frame_dim]
+        older = newest.repeat(*([1] * (stats.dim() - 1)), frames - own)
+        state[key] = torch.cat([stats[..., :cut], older, stats[..., cut:]], dim=-1)
+    weight = source[weight_key]
+    zeros = weight.new_zeros(weight.shape[0], extra)
+    state[weight_key] = torch.cat([weight[:, :cut], zeros, weight[:, cut:]], dim=1)
     return state
