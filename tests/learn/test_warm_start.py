@@ -116,6 +116,8 @@ def test_map_zero_start_refuses_a_recurrent_actor() -> None:
 
 
 def test_widen_history_inserts_silent_older_frames() -> None:
+    from types import SimpleNamespace
+
     from lca.learn.warm_start import widen_history
 
     frame, current, hidden = 3, 2, 4
@@ -129,7 +131,12 @@ def test_widen_history_inserts_silent_older_frames() -> None:
         "mlp.0.weight": weight,
         "mlp.0.bias": torch.ones(hidden),
     }
-    state = widen_history(source, obs_dim=4 * frame + current, frame_dim=frame, frames=4)
+
+    def target(obs_dim: int, **kw) -> SimpleNamespace:
+        normaliser = SimpleNamespace(_mean=torch.zeros(1, obs_dim))
+        return SimpleNamespace(obs_normalizer=normaliser, **kw)
+
+    state = widen_history(source, target(4 * frame + current), frame_dim=frame, frames=4)
     mean = state["obs_normalizer._mean"][0].tolist()
     assert mean == [0, 1, 2, 3, 4, 5, 0, 1, 2, 0, 1, 2, 6, 7]  # the newest frame's statistics
     assert state["obs_normalizer._std"][0, 6:9].tolist() == [200, 201, 202]
@@ -140,9 +147,11 @@ def test_widen_history_inserts_silent_older_frames() -> None:
     torch.testing.assert_close(widened[:, 4 * frame :], weight[:, 2 * frame :])
     assert state["obs_normalizer.count"] == 7 and state["mlp.0.bias"] is source["mlp.0.bias"]
     with pytest.raises(ValueError, match="task.observations.history=4"):
-        widen_history(source, obs_dim=4 * frame + current + 1, frame_dim=frame, frames=4)
-    with pytest.raises(ValueError, match="obs_normalizer"):
-        widen_history({"mlp.0.weight": weight}, obs_dim=10, frame_dim=frame, frames=4)
+        widen_history(source, target(4 * frame + current + 1), frame_dim=frame, frames=4)
+    with pytest.raises(ValueError, match="obs_normalization"):
+        widen_history(source, SimpleNamespace(obs_normalizer=None), frame_dim=frame, frames=4)
+    with pytest.raises(ValueError, match="recurrent"):
+        widen_history(source, target(14, is_recurrent=True), frame_dim=frame, frames=4)
 
 
 @pytest.mark.slow  # trains: see README

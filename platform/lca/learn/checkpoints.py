@@ -112,8 +112,7 @@ class Checkpoints:
             model = getattr(self.alg, name)
             source = saved[f"{name}_state_dict"]
             if algo.init_widen_history:
-                obs_dim = model.obs_normalizer._mean.shape[-1]
-                source = widen_history(source, obs_dim, frame_dim, frames)
+                source = widen_history(source, model, frame_dim, frames)
             if algo.init_map_zero:
                 source = zero_map_state(source, model, self.cfg.actor.activation)
             model.load_state_dict(source)

@@ -105,26 +105,30 @@ NORMALISER = ("obs_normalizer._mean", "obs_normalizer._var", "obs_normalizer._st
 
 
 def widen_history(
-    source: dict[str, torch.Tensor], obs_dim: int, frame_dim: int, frames: int
+    source: dict[str, torch.Tensor], target: nn.Module, frame_dim: int, frames: int
 ) -> dict[str, torch.Tensor]:
     """`source` (a model's state dict whose flat observation starts with its history, newest
-    frame first) as if its history held `frames` frames of `frame_dim` values and its flat
-    observation were `obs_dim` wide: older frames inserted after its own, with zero weights in
-    the first layer and the newest frame's normaliser statistics. Raises naming the key when
-    the widths do not fit a shorter history."""
+    frame first) as if its history held `frames` frames of `frame_dim` values, as `target`'s
+    does: older frames inserted after its own, with zero weights in the first layer and the
+    newest frame's normaliser statistics. Raises naming the key when the models do not fit."""
+    key = "algo.init_widen_history"
+    if getattr(target, "is_recurrent", False):
+        raise ValueError(f"{key}: a recurrent actor (actor=lstm) reads its history itself")
+    mean = getattr(getattr(target, "obs_normalizer", None), "_mean", None)
     weight_key = f"{FIRST_LAYER}.weight"
-    if NORMALISER[0] not in source or weight_key not in source:
+    if mean is None or NORMALISER[0] not in source or weight_key not in source:
         raise ValueError(
-            f"algo.init_widen_history: the source has no '{NORMALISER[0]}' or '{weight_key}': "
-            "it needs an MLP model with an observation normaliser"
+            f"{key}: needs MLP models with observation normalisers "
+            f"(algo.obs_normalization=true) and '{NORMALISER[0]}', '{weight_key}' in the source"
         )
-    extra = obs_dim - source[NORMALISER[0]].shape[-1]
+    obs_dim, source_dim = mean.shape[-1], source[NORMALISER[0]].shape[-1]
+    extra = obs_dim - source_dim
     own = frames - extra // frame_dim if frame_dim > 0 else 0
     if extra < 0 or frame_dim <= 0 or extra % frame_dim or own < 1:
         raise ValueError(
-            f"algo.init_widen_history: the source's observation is "
-            f"{source[NORMALISER[0]].shape[-1]} wide and this run's {obs_dim}: not a shorter "
-            f"history of {frame_dim}-value frames (task.observations.history={frames})"
+            f"{key}: the source's observation is {source_dim} wide and this run's {obs_dim}: "
+            f"not a shorter history of {frame_dim}-value frames "
+            f"(task.observations.history={frames})"
         )
     cut = own * frame_dim
     state = dict(source)
