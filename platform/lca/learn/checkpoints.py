@@ -116,14 +116,9 @@ class Checkpoints:
             if algo.init_map_zero:
                 source = zero_map_state(source, model, self.cfg.actor.activation)
             model.load_state_dict(source)
-        how = [
-            what
-            for what, on in (
-                ("its map's contribution zero", algo.init_map_zero),
-                (f"its history widened to {frames} frames", algo.init_widen_history),
-            )
-            if on
-        ]
+        how = ["its map's contribution zero"] if algo.init_map_zero else []
+        if algo.init_widen_history:
+            how.append(f"its history widened to {frames} frames")
         print(f"[lca] {self.run.path.name} starts from the networks of {path}, {', '.join(how)}")
 
     def _load_newest_readable(self) -> dict | None:

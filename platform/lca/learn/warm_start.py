@@ -111,32 +111,31 @@ def widen_history(
     frame first) as if its history held `frames` frames of `frame_dim` values, as `target`'s
     does: older frames inserted after its own, with zero weights in the first layer and the
     newest frame's normaliser statistics. Raises naming the key when the models do not fit."""
-    key = "algo.init_widen_history"
+    name = "algo.init_widen_history"
     if getattr(target, "is_recurrent", False):
-        raise ValueError(f"{key}: a recurrent actor (actor=lstm) reads its history itself")
+        raise ValueError(f"{name}: a recurrent actor (actor=lstm) reads its history itself")
     mean = getattr(getattr(target, "obs_normalizer", None), "_mean", None)
     weight_key = f"{FIRST_LAYER}.weight"
     if mean is None or NORMALISER[0] not in source or weight_key not in source:
         raise ValueError(
-            f"{key}: needs MLP models with observation normalisers "
+            f"{name}: needs MLP models with observation normalisers "
             f"(algo.obs_normalization=true) and '{NORMALISER[0]}', '{weight_key}' in the source"
         )
     obs_dim, source_dim = mean.shape[-1], source[NORMALISER[0]].shape[-1]
     extra = obs_dim - source_dim
-    own = frames - extra // frame_dim if frame_dim > 0 else 0
-    if extra < 0 or frame_dim <= 0 or extra % frame_dim or own < 1:
+    own = frames - extra // frame_dim  # the source's history length
+    if extra < 0 or extra % frame_dim or own < 1:
         raise ValueError(
-            f"{key}: the source's observation is {source_dim} wide and this run's {obs_dim}: "
+            f"{name}: the source's observation is {source_dim} wide and this run's {obs_dim}: "
             f"not a shorter history of {frame_dim}-value frames "
             f"(task.observations.history={frames})"
         )
     cut = own * frame_dim
     state = dict(source)
-    for key in NORMALISER:
+    for key in NORMALISER:  # (1, obs) statistics
         stats = source[key]
-        newest = stats[..., :frame_dim]
-        older = newest.repeat(*([1] * (stats.dim() - 1)), frames - own)
-        state[key] = torch.cat([stats[..., :cut], older, stats[..., cut:]], dim=-1)
+        older = stats[:, :frame_dim].repeat(1, frames - own)
+        state[key] = torch.cat([stats[:, :cut], older, stats[:, cut:]], dim=1)
     weight = source[weight_key]
     zeros = weight.new_zeros(weight.shape[0], extra)
     state[weight_key] = torch.cat([weight[:, :cut], zeros, weight[:, cut:]], dim=1)
