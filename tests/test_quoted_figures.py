@@ -51,7 +51,7 @@ def test_quoted_flat_cell_figures_match_the_shipped_summary(doc: str, policy: st
 # reports/learning.md's table of the reference recipe: a row per shipped policy, one column
 # per cell in this order, each "success [CI] / tracking / contacts per step"
 LEARNING_ROWS = {
-    "**R1 (the default)**": "blind",
+    "**Q1 (the default)**": "blind",
     "R1, One-Stage MLP": "one_mlp",
     "R1, Two-Stage MLP": "two_mlp",
     "R1, One-Stage CNN": "one_cnn",

@@ -96,30 +96,60 @@ def test_training_run_ends_on_the_paper_objective(tmp_path, smoke_scene):
     assert all(np.isfinite(float(r["kl"])) for r in rows)  # the adaptive schedule's KL
 
 
-@pytest.mark.slow  # trains: see README
-def test_the_paper_phase_warms_the_critic_then_holds_a_low_rate(tmp_path, smoke_scene):
-    """algo.final_*: from the cut (iteration 2 of 5) the critic trains alone for one
-    iteration, then the actor too, at the fixed final learning rate."""
-    cfg = smoke_cfg(
-        "scale.max_iterations=5",
-        "task.reward_curriculum.enabled=true",
-        "task.reward_curriculum.by=iterations",
-        "task.reward_curriculum.cut=0.4",
-        "algo.final_critic_warmup=1",
-        "algo.final_learning_rate=2.0e-5",
-    )
-    trainer = make_trainer(cfg, tmp_path / "run", smoke_scene)
+FINAL_PHASE = (
+    "scale.max_iterations=5",
+    "task.reward_curriculum.enabled=true",
+    "task.reward_curriculum.by=iterations",
+    "algo.final_critic_warmup=1",
+    "algo.final_learning_rate=2.0e-5",
+)
+
+
+def train_final_phase(path, scene, *overrides: str):
+    """Five iterations with a final phase: the curve's rows, whether the actor moved at each
+    update, and the trainer."""
+    trainer = make_trainer(smoke_cfg(*FINAL_PHASE, *overrides), path, scene)
     actor = []
     trainer.train(
         hook=lambda t, it, row: actor.append(t.alg.actor.state_dict()["mlp.0.weight"].clone())
     )
-    rows = read_curve(tmp_path / "run" / "train_curve.csv")
+    moved = [not torch.equal(a, b) for a, b in zip(actor, actor[1:], strict=False)]
+    return read_curve(path / "train_curve.csv"), moved, trainer
+
+
+@pytest.mark.slow  # trains: see README
+def test_the_paper_phase_warms_the_critic_then_holds_a_low_rate(tmp_path, smoke_scene):
+    """algo.final_*: from the cut (iteration 2 of 5) the critic trains alone for one
+    iteration, then the actor too, at the fixed final learning rate."""
+    rows, moved, trainer = train_final_phase(
+        tmp_path / "run", smoke_scene, "task.reward_curriculum.cut=0.4"
+    )
     assert [float(r["penalty_scale"]) < 1 for r in rows] == [True, True, False, False, False]
     assert [float(r["learning_rate"]) for r in rows][2:] == [2.0e-5] * 3
     assert float(rows[1]["learning_rate"]) != 2.0e-5
-    moved = [not torch.equal(a, b) for a, b in zip(actor, actor[1:], strict=False)]
     assert moved == [True, False, True, True]  # iteration 2 trained the critic only
     assert trainer.alg.schedule == "fixed"
+
+
+@pytest.mark.slow  # trains: see README
+def test_the_last_phase_can_start_after_the_curriculum_ends(tmp_path, smoke_scene):
+    """algo.final_from: the table's weights from iteration 1 (deadline 0.2 of 5), the
+    critic alone at iteration 3 (final_from 0.6), then the fixed final rate."""
+    rows, moved, _ = train_final_phase(
+        tmp_path / "run",
+        smoke_scene,
+        "task.reward_curriculum.deadline=0.2",
+        "algo.final_from=0.6",
+    )
+    assert [float(r["penalty_scale"]) for r in rows][1:] == [1.0] * 4
+    rates = [float(r["learning_rate"]) for r in rows]
+    assert rates[3:] == [2.0e-5] * 2 and 2.0e-5 not in rates[:3]
+    assert moved == [True, True, False, True]  # iteration 3 trained the critic only
+
+
+def test_final_from_names_its_key_when_out_of_range():
+    with pytest.raises(Exception, match="algo.final_from"):
+        smoke_cfg("algo.final_from=1.5")
 
 
 def test_iteration_ramp_is_linear_to_the_deadline():

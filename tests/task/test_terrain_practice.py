@@ -42,7 +42,7 @@ def test_a_kind_with_no_share_gets_no_env():
         (["+terrain.practice={ledge: 1.0}", "terrain.practice_end=0.5"], "terrain.practice.ledge"),
         (["+terrain.practice={stairs_up: 0.6}", "terrain.practice_end=0.5"], "terrain.practice"),
         ([ALL_PITS], END),
-        ([ALL_PITS, f"{END}=1.0"], END),
+        ([ALL_PITS, f"{END}=1.5"], END),
         (["terrain.practice_end=0.5"], "terrain.practice"),
         ([ALL_PITS, f"{END}=0.5", "terrain.practice_start=0.5"], "terrain.practice_start"),
     ],

@@ -125,6 +125,9 @@ class AlgoConfig:
     # the critic alone on the new returns
     final_learning_rate: float = 0.0
     final_critic_warmup: int = 0
+    # fraction of the run from which the two above apply instead of the curriculum's end
+    # (-1: that end), e.g. a last phase that starts after a spell on the table's weights
+    final_from: float = -1.0
 
     def check(self) -> None:
         def positive(key: str) -> None:
@@ -140,6 +143,11 @@ class AlgoConfig:
         require(self.critic_warmup >= 0, "algo.critic_warmup", "must be >= 0")
         require(self.final_critic_warmup >= 0, "algo.final_critic_warmup", "must be >= 0")
         require(self.final_learning_rate >= 0, "algo.final_learning_rate", "must be >= 0")
+        require(
+            self.final_from == -1.0 or 0 <= self.final_from <= 1,
+            "algo.final_from",
+            f"must be in [0, 1] or -1 (the curriculum's end), got {self.final_from}",
+        )
         for key in ("num_steps_per_env", "num_learning_epochs", "num_mini_batches"):
             at_least_one(key)
         for key in ("entropy_coef", "value_loss_coef", "mirror_loss_coeff"):

@@ -39,6 +39,7 @@ def build_train_cfg(cfg: DictConfig, run_name: str) -> dict:
         "critic_warmup",
         "final_learning_rate",
         "final_critic_warmup",
+        "final_from",
     ):
         algo.pop(key)
     obs_normalization = algo.pop("obs_normalization")

@@ -151,8 +151,11 @@ class Trainer(Checkpoints):
         """Critic warm-ups (after a warm start; after the reward curriculum ends): the
         actor's parameters out of the update and the learning rate held (no KL to adapt it
         to); at the end the configured rate is set again. From the curriculum's end (its
-        cut or deadline) with `final_learning_rate`, that rate, fixed."""
+        cut or deadline; `algo.final_from` if set) with `final_learning_rate`, that rate,
+        fixed."""
         a, end = self.cfg.algo, self.rewards.end
+        if a.final_from >= 0:
+            end = math.ceil(a.final_from * self.total)
         frozen = it < a.critic_warmup or end <= it < end + a.final_critic_warmup
         actor = self.alg.actor
         was_frozen = not next(actor.parameters()).requires_grad

@@ -147,7 +147,8 @@ class TerrainConfig:
     after_levels: str = "top_row"
     # practice (not in the paper): until practice_end (a fraction of the run) the envs respawn
     # on the tile kinds in these shares ({stairs_up: 0.5, ...}) instead of evenly over the
-    # grid; the terrain is unchanged, and from practice_end on the spread is even again.
+    # grid; the terrain is unchanged, and from practice_end on the spread is even again
+    # (1: the run ends while it practises).
     # Set it with a leading +: `+terrain.practice={stairs_up: 0.5, flat: 0.5}`
     practice: dict[str, float] = field(default_factory=dict)
     practice_start: float = 0.0  # from here (e.g. after a levelled start) until practice_end
@@ -226,10 +227,9 @@ class TerrainConfig:
             f"shares must be >= 0 and sum to 1, got {share}",
         )
         require(
-            0 < self.practice_end < 1,
+            0 < self.practice_end <= 1,
             "terrain.practice_end",
-            f"must be in (0, 1) with terrain.practice set (the run ends on the even spread), "
-            f"got {self.practice_end}",
+            f"must be in (0, 1] with terrain.practice set, got {self.practice_end}",
         )
         require(
             0 <= self.practice_start < self.practice_end,
