@@ -52,7 +52,7 @@ def test_quoted_flat_cell_figures_match_the_shipped_summary(doc: str, policy: st
 # per cell in this order, each "success [CI] / tracking / contacts per step"
 LEARNING_ROWS = {
     "**Q1 (the default)**": "blind",
-    "R1, One-Stage MLP": "one_mlp",
+    "Q1, One-Stage MLP": "one_mlp",
     "R1, Two-Stage MLP": "two_mlp",
     "R1, One-Stage CNN": "one_cnn",
     "R1, Two-Stage CNN": "two_cnn",
