@@ -115,6 +115,12 @@ class Trainer(Checkpoints):
             cfg.task.reward_curriculum, self.total, (infos or {}).get("penalty_scale")
         )
         self.commands = CommandCurriculum(cfg.task.command_curriculum, self.total)
+        # the first iteration of the last phase (final_*): algo.final_from, else the
+        # curriculum's end
+        final_from = cfg.algo.final_from
+        self.final_start = (
+            math.ceil(final_from * self.total) if final_from >= 0 else self.rewards.end
+        )
         self.stopped_early = False
 
     def levels_over(self, iteration: int) -> bool:
@@ -153,9 +159,7 @@ class Trainer(Checkpoints):
         to); at the end the configured rate is set again. From the curriculum's end (its
         cut or deadline; `algo.final_from` if set) with `final_learning_rate`, that rate,
         fixed."""
-        a, end = self.cfg.algo, self.rewards.end
-        if a.final_from >= 0:
-            end = math.ceil(a.final_from * self.total)
+        a, end = self.cfg.algo, self.final_start
         frozen = it < a.critic_warmup or end <= it < end + a.final_critic_warmup
         actor = self.alg.actor
         was_frozen = not next(actor.parameters()).requires_grad
