@@ -53,7 +53,7 @@ def test_quoted_flat_cell_figures_match_the_shipped_summary(doc: str, policy: st
 LEARNING_ROWS = {
     "**Q1 (the default)**": "blind",
     "Q1, One-Stage MLP": "one_mlp",
-    "R1, Two-Stage MLP": "two_mlp",
+    "Q1, Two-Stage MLP": "two_mlp",
     "R1, One-Stage CNN": "one_cnn",
     "R1, Two-Stage CNN": "two_cnn",
 }
