@@ -31,6 +31,9 @@ PACKAGES = ("lca", "torch", "mujoco", "mjbatch", "rsl-rl-lib", "hydra-core", "nu
 COMPLETE = "COMPLETE"
 TRAIN_CFG = "train_cfg.json"
 FAILED = "FAILED"
+PROVENANCE = "provenance.json"
+# what `earlier_starts` keeps of each start before this one
+START_KEYS = ("started", "argv", "git", "host", "platform", "cpu", "resumed")
 KEEP_ON_FORCE = (".hydra", LOCK)  # Hydra writes .hydra/ before the job starts
 
 
@@ -65,6 +68,18 @@ def git_state(repo: Path) -> dict:
         "commit": commit or None,
         "dirty": bool(git("status", "--porcelain")) if commit else None,
     }
+
+
+def cpu_model() -> str:
+    """The CPU's model name, '' where unknown: machines of one kind differ in speed, so a
+    wall-clock figure needs its machine."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor()
 
 
 def versions() -> dict:
@@ -176,8 +191,11 @@ class RunDir:
                 entry.unlink()
 
     def write_provenance(self, cfg: DictConfig, overrides: list[str], choices: dict) -> None:
+        """config.yaml and provenance.json of this start. A run started before (interrupted,
+        resumed) keeps its earlier starts in `earlier_starts`, oldest first."""
         repo = root()
         atomic_write(self.path / "config.yaml", OmegaConf.to_yaml(cfg, resolve=True))
+        previous = self.provenance()
         provenance = {
             "overrides": list(overrides),
             "choices": dict(choices),
@@ -188,10 +206,29 @@ class RunDir:
             "platform": platform.platform(),
             "host": socket.gethostname(),
             "argv": sys.argv,
+            "cpu": cpu_model(),
             "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
             "departures_from_paper": departures(cfg),
         }
-        atomic_write(self.path / "provenance.json", json.dumps(provenance, indent=2))
+        if previous:
+            start = {key: previous[key] for key in START_KEYS if key in previous}
+            provenance["earlier_starts"] = [*previous.get("earlier_starts", []), start]
+        atomic_write(self.path / PROVENANCE, json.dumps(provenance, indent=2))
+
+    def provenance(self) -> dict:
+        """provenance.json ({} before the run's first start)."""
+        path = self.path / PROVENANCE
+        return json.loads(path.read_text()) if path.exists() else {}
+
+    def record_resume(self, iteration: int, checkpoint: str, exact: bool) -> None:
+        """Note in provenance.json that this start resumed at `iteration` from `checkpoint`,
+        `exact` when the optimizer and the environments' state came with the networks (a
+        shipped, networks-only checkpoint restarts both)."""
+        provenance = self.provenance()
+        if not provenance:  # a trainer built outside the pipeline (tests, benchmarks)
+            return
+        provenance["resumed"] = {"iteration": iteration, "from": checkpoint, "exact": exact}
+        atomic_write(self.path / PROVENANCE, json.dumps(provenance, indent=2))
 
     def write_train_cfg(self, train_cfg: dict) -> None:
         """The rsl-rl runner config the run trains with: evaluation rebuilds the networks

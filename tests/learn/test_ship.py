@@ -41,6 +41,9 @@ def test_resumable_ship_is_networks_only_and_resumes_at_its_iteration(
 
     resumed = make_trainer(cfg, tmp_path / "shipped", smoke_scene)
     assert resumed.start == 3
+    # networks only: a fresh optimizer and fresh environments, and provenance says so
+    resume = resumed.run.provenance()["resumed"]
+    assert resume == {"iteration": 3, "from": "latest.pt", "exact": False}
     assert resumed.alg.learning_rate == rate  # the run's adapted rate, not the configured one
     weight = "mlp.0.weight"
     torch.testing.assert_close(

@@ -173,6 +173,12 @@ def test_killed_run_resumes(tmp_path) -> None:
     assert (run / "COMPLETE").is_file()
     marker = json.loads((run / "COMPLETE").read_text())
     assert marker["final"]["iteration"] == 5
+    # provenance keeps the killed start and says how this one resumed
+    provenance = json.loads((run / "provenance.json").read_text())
+    assert provenance["resumed"] == {"iteration": ckpt_iter + 1, "from": "latest.pt", "exact": True}
+    [killed_start] = provenance["earlier_starts"]
+    assert "resumed" not in killed_start and killed_start["started"] <= provenance["started"]
+    assert killed_start["cpu"] == provenance["cpu"]
     rows = read_curve(curve)
     assert [int(r["iteration"]) for r in rows] == list(range(6))
     assert rows[: len(kept)] == kept  # rows up to the checkpoint kept as they were

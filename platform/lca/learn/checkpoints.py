@@ -146,6 +146,8 @@ class Checkpoints:
             self.runner.current_learning_iteration = int(saved["iter"])
             self.start = self.runner.current_learning_iteration + 1
             self._restore_loop_state(saved, path)
+            exact = parts["optimizer"] and saved.get(LOOP_STATE) is not None
+            self.run.record_resume(self.start, name, exact)
             print(
                 f"[lca] resuming {self.run.path.name} at iteration {self.start}/{self.total}"
                 f" (from {name})"
