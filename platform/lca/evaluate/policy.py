@@ -5,7 +5,6 @@ from __future__ import annotations
 import contextlib
 import copy
 import io
-import json
 from pathlib import Path
 
 from omegaconf import DictConfig, OmegaConf
@@ -28,8 +27,7 @@ def load_run_config(run_dir: Path, overrides: list[str] | None = None) -> DictCo
     cfg = OmegaConf.merge(OmegaConf.structured(schema.LcaConfig), OmegaConf.load(path))
     validate(cfg)
     if overrides:
-        provenance = Path(run_dir) / "provenance.json"
-        own = json.loads(provenance.read_text()).get("overrides", []) if provenance.exists() else []
+        own = RunDir(run_dir).provenance().get("overrides", [])
         cfg = override_config(cfg, list(overrides), own)
     return cfg
 

@@ -23,11 +23,11 @@ from lca.evaluate.policy import final_checkpoint
 from lca.evaluate.protocol import PROTOCOL_VERSION
 from lca.evaluate.run import evaluate_and_write
 from lca.paths import assets_dir
-from lca.store import COMPLETE
+from lca.store import COMPLETE, PROVENANCE
 
 MARK = " (reference: {name})"
 # what a reference run carries over from the shipped one: no exports, clips or results
-KEEP = ("config.yaml", "provenance.json", "train_cfg.json", "train_curve.csv", COMPLETE)
+KEEP = ("config.yaml", PROVENANCE, "train_cfg.json", "train_curve.csv", COMPLETE)
 NO_MEDIA = {"videos": False, "reference": []}
 
 
