@@ -13,6 +13,7 @@ from omegaconf import OmegaConf
 from lca import experiment
 from lca.config import compose
 from lca.paths import root
+from lca.shipped import evaluated_copy, shipped_name, shipped_runs
 
 REFERENCE = root() / "experiments" / "reference.yaml"
 BLIND_FLAT = root() / "assets" / "policies" / "blind_flat"
@@ -37,14 +38,15 @@ def test_every_policy_uses_the_paper_cnn_and_full_body_collisions():
     assert set(cfg.robot.collision_parts) == {"feet", "legs", "torso", "arms"}
 
 
-def _ship(shipped: Path, name: str) -> None:
-    """A copy of the flat walker shipped as `name`: the blind MLP's networks are those of an
-    MLP-encoder policy of any curriculum (its encoder untrained)."""
-    folder = shipped / name
+def _ship(shipped: Path, name: str, seed: int = 0) -> None:
+    """A copy of the flat walker shipped as policy `name`'s training seed `seed`: the blind
+    MLP's networks are those of an MLP-encoder policy of any curriculum (its encoder
+    untrained)."""
+    folder = shipped / shipped_name(name, seed)
     shutil.copytree(BLIND_FLAT, folder, ignore=shutil.ignore_patterns("*.onnx", "*.jit", "*.pt2"))
     cfg = OmegaConf.load(folder / "config.yaml")
     named = compose([f"policy={name}"])
-    cfg.curriculum, cfg.policy = named.curriculum, named.policy
+    cfg.curriculum, cfg.policy, cfg.seed = named.curriculum, named.policy, seed
     OmegaConf.save(cfg, folder / "config.yaml")
 
 
@@ -54,8 +56,10 @@ def test_evaluate_only_reports_two_shipped_policies(tmp_path):
     shipped.mkdir()
     shutil.copytree(BLIND_FLAT, shipped / "blind")
     _ship(shipped, "two_mlp")
+    _ship(shipped, "two_mlp", seed=1)  # a second training seed ships beside the first
     spec = OmegaConf.to_container(OmegaConf.load(REFERENCE))
     spec |= {"shipped": str(shipped), "report": str(tmp_path / "report"), "hardware": True}
+    spec["seeds"] = [0, 1]
     spec["overrides"] = ["scale=smoke", "eval.units=4", "eval.steps=30"]
     spec["overrides"] += [
         "hardware.trials=2",
@@ -74,42 +78,72 @@ def test_evaluate_only_reports_two_shipped_policies(tmp_path):
     assert list(dict.fromkeys(table["policy"])) == ["Blind", "Two-Stage MLP"]
     cells = {(t, d) for t in ("stairs", "uneven") for d in ("medium", "hard")}
     metrics = {"success", "contacts_per_step", "track_cm_s"}
-    for _, rows in table.groupby("policy"):
+    for policy, rows in table.groupby("policy"):
         assert set(zip(rows["terrain"], rows["difficulty"], strict=True)) == cells
-        assert set(rows["metric"]) == metrics and (rows["n_units"] == 4).all()
+        seeds = 2 if policy == "Two-Stage MLP" else 1  # its two seeds' units pooled
+        assert set(rows["metric"]) == metrics and (rows["n_units"] == 4 * seeds).all()
+        assert (rows["n_seeds"] == seeds).all()
     assert (report / "claim.csv").is_file()  # the paired two-stage - one-stage comparison
     assert (report / "sim_table.tex").is_file() and (report / "index.html").is_file()
     training = pd.read_csv(report / "training.csv")
-    assert list(training["policy"]) == ["blind", "two_mlp"]
+    assert list(zip(training["policy"], training["seed"], strict=True)) == [
+        ("blind", 0),
+        ("two_mlp", 0),
+        ("two_mlp", 1),
+    ]
     curve = pd.read_csv(BLIND_FLAT / "train_curve.csv").iloc[-1]
-    assert training["env_steps"].tolist() == [int(curve["env_steps"])] * 2
+    assert training["env_steps"].tolist() == [int(curve["env_steps"])] * 3
     assert (tmp_path / "runs" / "evaluated" / "blind" / "summary.csv").is_file()
     evaluated = OmegaConf.load(tmp_path / "runs" / "evaluated" / "two_mlp" / "config.yaml")
     assert evaluated.sim.num_threads == 1
     # the hardware-style tasks ran beside the cells, in copies of their own, then joined
-    for policy in ("blind", "two_mlp"):
-        trials = pd.read_csv(tmp_path / "runs" / "evaluated" / policy / "hardware.csv")
+    evaluated = ["blind", "two_mlp", "two_mlp-seed1"]
+    for name in evaluated:
+        trials = pd.read_csv(tmp_path / "runs" / "evaluated" / name / "hardware.csv")
         assert list(trials["task"]) == ["soft_ledge"] * 2
-    assert sorted(p.name for p in (tmp_path / "runs" / "evaluated").iterdir()) == [
-        "blind",
-        "two_mlp",
-    ]
+    assert sorted(p.name for p in (tmp_path / "runs" / "evaluated").iterdir()) == evaluated
     assert set(pd.read_csv(report / "hardware_table.csv")["policy"]) >= {"Blind", "Two-Stage MLP"}
+
+
+def _mark_shipped(shipped: Path, policy: str, seed: int, trained_seed: int | None = None) -> None:
+    folder = shipped / shipped_name(policy, seed)
+    folder.mkdir(parents=True)
+    (folder / "COMPLETE").touch()
+    OmegaConf.save({"seed": seed if trained_seed is None else trained_seed}, folder / "config.yaml")
 
 
 def test_a_shipped_policy_is_not_trained_again(tmp_path, capsys):
     shipped = tmp_path / "shipped"
-    (shipped / "blind").mkdir(parents=True)
-    (shipped / "blind" / "COMPLETE").touch()
+    _mark_shipped(shipped, "blind", 0)
+    _mark_shipped(shipped, "two_mlp", 1)
     spec = OmegaConf.to_container(OmegaConf.load(REFERENCE))
-    spec |= {"shipped": str(shipped)}
+    spec |= {"shipped": str(shipped), "seeds": [0, 1]}
     file = tmp_path / "reference.yaml"
     OmegaConf.save(OmegaConf.create(spec), file)
     assert experiment.main([str(file), "--dry-run"]) == 0
     out = capsys.readouterr().out
-    assert "shipped already, not trained again: blind" in out
-    planned = [line.split()[0] for line in out.splitlines() if line.startswith("  policy=")]
-    assert planned == [f"policy={p}" for p in spec["policies"] if p != "blind"]
+    assert "shipped already, not trained again: blind, two_mlp-seed1" in out
+    planned = [tuple(line.split()[:2]) for line in out.splitlines() if line.startswith("  policy=")]
+    expected = [
+        (f"policy={p}", f"seed={s}")
+        for s in (0, 1)
+        for p in spec["policies"]
+        if (p, s) not in {("blind", 0), ("two_mlp", 1)}
+    ]
+    assert sorted(planned) == sorted(expected)
+    # a multirun is a product of policies and seeds: one per seed that misses others
+    commands = [line for line in out.splitlines() if line.startswith("command:")]
+    seeds = [next(t for t in c.split() if t.startswith("seed=")) for c in commands]
+    assert seeds == ["seed=0", "seed=1"]
+
+
+def test_a_shipped_folder_must_hold_the_seed_its_name_says(tmp_path):
+    shipped = tmp_path / "shipped"
+    _mark_shipped(shipped, "one_mlp", 1, trained_seed=0)
+    spec = {"policies": ["one_mlp"], "seeds": [0, 1], "shipped": str(shipped)}
+    named = "one_mlp-seed1: its run trained seed 0, its name says seed 1"
+    with pytest.raises(ValueError, match=named):
+        shipped_runs(spec)
 
 
 def test_the_default_job_shows_the_shipped_reference_policies() -> None:
@@ -119,3 +153,28 @@ def test_the_default_job_shows_the_shipped_reference_policies() -> None:
     assert list(cfg.eval.reference) == ["blind_flat", "blind"]
     for name in cfg.eval.reference:
         assert (root() / "assets" / "policies" / name / "COMPLETE").is_file(), name
+
+
+def test_an_evaluated_copy_keeps_its_rounds_only_from_the_same_origin(tmp_path):
+    """A second --evaluate-only goes on from the first one's finished rounds, unless the
+    checkpoint or the thread count (both change results) differ."""
+    shipped = tmp_path / "shipped"
+    _ship(shipped, "two_mlp")
+    out = tmp_path / "runs" / "evaluated" / "two_mlp"
+    evaluated_copy("two_mlp", shipped / "two_mlp", out, ["scale=smoke"], threads=1)
+    finished = out / "eval" / "stairs-medium" / "episode_0.csv"
+    finished.parent.mkdir(parents=True)
+    finished.write_text("unit\n0\n")
+
+    evaluated_copy("two_mlp", shipped / "two_mlp", out, ["scale=smoke"], threads=1)
+    assert finished.read_text() == "unit\n0\n"
+    assert OmegaConf.load(out / "config.yaml").sim.num_threads == 1
+
+    evaluated_copy("two_mlp", shipped / "two_mlp", out, ["scale=smoke"], threads=2)
+    assert not finished.exists()  # another thread count: evaluated afresh
+    finished.parent.mkdir(parents=True)
+    finished.write_text("unit\n0\n")
+    checkpoint = next((shipped / "two_mlp" / "checkpoints").glob("*.pt"))
+    checkpoint.write_bytes(checkpoint.read_bytes() + b"\0")
+    evaluated_copy("two_mlp", shipped / "two_mlp", out, ["scale=smoke"], threads=2)
+    assert not finished.exists()  # another checkpoint: evaluated afresh

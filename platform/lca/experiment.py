@@ -41,6 +41,20 @@ def load_experiment(path: Path) -> dict:
     return spec
 
 
+def missing_sweeps(spec: dict, done: set[tuple[str, int]]) -> list[dict]:
+    """The multiruns that train every (policy, seed) of `spec` not in `done`: a multirun is a
+    product of policies and seeds, so the seeds that miss the same policies share one."""
+    missing: dict[int, list[str]] = {}
+    for seed in spec["seeds"]:
+        policies = [p for p in spec["policies"] if (p, int(seed)) not in done]
+        if policies:
+            missing[seed] = policies
+    groups: dict[tuple[str, ...], list[int]] = {}
+    for seed, policies in missing.items():
+        groups.setdefault(tuple(policies), []).append(seed)
+    return [spec | {"policies": list(p), "seeds": seeds} for p, seeds in groups.items()]
+
+
 def sweep_command(spec: dict, extra: list[str], runs_root: str) -> list[str]:
     return [
         sys.executable,
@@ -104,21 +118,23 @@ def main(argv: list[str] | None = None) -> int:
         from lca.shipped import evaluate_only
 
         return evaluate_only(spec, spec["overrides"] + extra, Path(REPO, runs_root), jobs=args.jobs)
-    if "shipped" in spec:  # a policy that ships is not trained again
-        from lca.shipped import shipped_policies
+    sweeps = [spec]
+    if "shipped" in spec:  # a (policy, seed) that ships is not trained again
+        from lca.shipped import shipped_name, shipped_runs
 
-        done = shipped_policies(spec)
+        done = shipped_runs(spec)
         if done:
-            print(f"[lca] shipped already, not trained again: {', '.join(done)}")
-        spec["policies"] = [p for p in spec["policies"] if p not in done]
-        if not spec["policies"]:
+            names = ", ".join(shipped_name(*pair) for pair in done)
+            print(f"[lca] shipped already, not trained again: {names}")
+        sweeps = missing_sweeps(spec, set(done))
+        if not sweeps:
             print("[lca] every policy ships: nothing to train (--evaluate-only reports them)")
             return 0
     if args.dry_run:
-        plan = list(itertools.product(spec["policies"], spec["seeds"]))
+        plan = [pair for s in sweeps for pair in itertools.product(s["policies"], s["seeds"])]
         for policy, seed in plan:
             print(f"  policy={policy} seed={seed} {' '.join(spec['overrides'] + extra)}")
-        cost = estimate_seconds([f"policy={spec['policies'][0]}", *spec["overrides"], *extra])
+        cost = estimate_seconds([f"policy={plan[0][0]}", *spec["overrides"], *extra])
         print(f"{len(plan)} runs into {runs_root}/ with launcher '{spec['launcher']}'")
         print(
             f"per run: {cost['train_env_steps']:,} training + {cost['eval_env_steps']:,} "
@@ -139,10 +155,13 @@ def main(argv: list[str] | None = None) -> int:
                 "estimated cost: unknown (run `python -m lca.bench train` and `python -m "
                 f"lca.bench env` with sim.backend={cost['backend']} to measure throughput)"
             )
-        print("command:", " ".join(sweep_command(spec, extra, runs_root)))
+        for s in sweeps:
+            print("command:", " ".join(sweep_command(s, extra, runs_root)))
         return 0
     training = [o for o in extra if not o.startswith("hardware.")]  # not part of a run's identity
-    code = subprocess.call(sweep_command(spec, training, runs_root), cwd=REPO)
+    code = 0
+    for s in sweeps:
+        code = code or subprocess.call(sweep_command(s, training, runs_root), cwd=REPO)
     if code != 0 or spec["table"] != "hardware":
         return code
     return run_hardware_stage(spec, extra, Path(REPO, runs_root))

@@ -2,8 +2,9 @@
 
     python -m lca.experiment experiments/reference.yaml --evaluate-only [overrides]
 
-Each policy of the file that ships under `<shipped>/<policy>/` (default `assets/policies/`) is
-copied into `<runs_root>/evaluated/<policy>/` (config, provenance, curve, final checkpoint),
+Each (policy, seed) of the file that ships under `<shipped>/<policy>/` (seed 0; seed k under
+`<shipped>/<policy>-seed<k>/`; default `assets/policies/`) is copied into
+`<runs_root>/evaluated/<that folder's name>/` (config, provenance, curve, final checkpoint),
 given the evaluation and hardware settings the experiment composes for it (the same cells,
 seeds and sizes for every policy), evaluated (tables' results, clips), run through the
 hardware-style tasks, and the report is built into the file's `report` folder together with
@@ -18,6 +19,8 @@ other steps its physics (reports/benchmarks.md).
 
 from __future__ import annotations
 
+import hashlib
+import itertools
 import json
 import multiprocessing
 import shutil
@@ -35,36 +38,73 @@ from lca.evaluate.run import evaluate_and_write
 from lca.paths import root
 from lca.report.build import build_report
 from lca.report.reference import copy_run
-from lca.store import COMPLETE
+from lca.store import COMPLETE, atomic_write, cpu_model
 
 
 def shipped_dir(spec: dict) -> Path:
     return root() / spec.get("shipped", "assets/policies")
 
 
-def shipped_policies(spec: dict) -> list[str]:
-    """The policies of `spec` that ship complete under its `shipped` folder."""
+def shipped_name(policy: str, seed: int) -> str:
+    """The folder a policy's training seed ships in: the policy's own name for seed 0 (the
+    reference set's first), `<policy>-seed<k>` for seed k."""
+    return policy if int(seed) == 0 else f"{policy}-seed{seed}"
+
+
+def shipped_runs(spec: dict) -> dict[tuple[str, int], Path]:
+    """Every (policy, seed) of `spec` that ships complete under its `shipped` folder, in the
+    file's order (policies, then seeds). A folder whose run trained another seed than its
+    name says raises, naming both."""
     shipped = shipped_dir(spec)
-    return [p for p in spec["policies"] if (shipped / p / COMPLETE).exists()]
+    found = {}
+    for policy, seed in itertools.product(spec["policies"], spec["seeds"]):
+        folder = shipped / shipped_name(policy, seed)
+        if not (folder / COMPLETE).exists():
+            continue
+        trained = OmegaConf.load(folder / "config.yaml").seed
+        if int(trained) != int(seed):
+            raise ValueError(
+                f"{folder}: its run trained seed {trained}, its name says seed {seed} "
+                f"(seed {trained} ships as {shipped_name(policy, trained)}/)"
+            )
+        found[(policy, int(seed))] = folder
+    return found
 
 
 def evaluated_copy(
     policy: str, shipped: Path, out: Path, overrides: list[str], threads: int = 0
 ) -> Path:
     """A fresh run directory `out` holding `shipped`'s policy, with the evaluation and
-    hardware settings of `policy=<policy> <overrides>` (and `threads` physics threads)."""
+    hardware settings of `policy=<policy> <overrides>` (and `threads` physics threads).
+    Finished rounds of an earlier copy stay when they came from the same checkpoint, thread
+    count and CPU (the three that change results; the rounds' own stamp covers the
+    evaluation settings), so an interrupted or extended evaluation goes on where it was."""
     composed = compose([f"policy={policy}", *overrides])
     evaluation = OmegaConf.merge(composed.eval, {"reference": []})
     sim = {"num_threads": threads} if threads else {}
-    copy_run(
-        shipped,
-        out,
-        final_checkpoint(shipped),
-        eval=evaluation,
-        hardware=composed.hardware,
-        sim=sim,
-    )
+    checkpoint = final_checkpoint(shipped)
+    origin = {
+        "checkpoint_sha256": hashlib.sha256(checkpoint.read_bytes()).hexdigest(),
+        "threads": threads,
+        "cpu": cpu_model(),
+    }
+    rounds, kept = out / "eval", out.parent / f".{out.name}.eval"
+    if rounds.is_dir() and _origin(out) == origin:
+        shutil.rmtree(kept, ignore_errors=True)
+        rounds.replace(kept)
+    copy_run(shipped, out, checkpoint, eval=evaluation, hardware=composed.hardware, sim=sim)
+    if kept.is_dir():
+        kept.replace(rounds)
+    atomic_write(out / ORIGIN, json.dumps(origin, indent=1) + "\n")
     return out
+
+
+ORIGIN = "evaluated_from.json"  # what an evaluated copy's rounds came from
+
+
+def _origin(run: Path) -> dict | None:
+    path = run / ORIGIN
+    return json.loads(path.read_text()) if path.is_file() else None
 
 
 def evaluate_part(
@@ -94,17 +134,18 @@ def join_hardware(source: Path, run: Path) -> None:
     shutil.rmtree(source)
 
 
-def training_table(runs: dict[str, Path]) -> pd.DataFrame:
-    """One row per policy: the environment steps and wall-clock of its run (its curve's last
-    row), and where it started (a warm start's checkpoint, from its config)."""
+def training_table(runs: dict[tuple[str, int], Path]) -> pd.DataFrame:
+    """One row per (policy, seed): the environment steps and wall-clock of its run (its
+    curve's last row), and where it started (a warm start's checkpoint, from its config)."""
     rows = []
-    for policy, run in runs.items():
+    for (policy, seed), run in runs.items():
         last = pd.read_csv(run / "train_curve.csv").iloc[-1]
         cfg = OmegaConf.load(run / "config.yaml")
         start = cfg.algo.get("init_from", "") or ""
         rows.append(
             {
                 "policy": policy,
+                "seed": seed,
                 "label": cfg.policy.label,
                 "iterations": int(last["iteration"]) + 1,
                 "env_steps": int(last["env_steps"]),
@@ -125,11 +166,15 @@ def _run_steps(run: Path) -> int:
 def evaluate_only(
     spec: dict, overrides: list[str], runs_root: Path, log=print, jobs: int | None = None
 ) -> int:
-    """Evaluate every shipped policy of `spec`, `jobs` at a time (default: the file's
+    """Evaluate every shipped (policy, seed) of `spec`, `jobs` at a time (default: the file's
     `evaluate_jobs`, else 1), then build its report. Returns an exit code."""
     shipped = shipped_dir(spec)
-    found = {p: shipped / p for p in shipped_policies(spec)}
-    missing = [p for p in spec["policies"] if p not in found]
+    found = shipped_runs(spec)
+    missing = [
+        shipped_name(*pair)
+        for pair in itertools.product(spec["policies"], spec["seeds"])
+        if pair not in found
+    ]
     if not found:
         log(
             f"[lca] --evaluate-only: none of {spec['policies']} ships under {shipped}/ "
@@ -142,7 +187,7 @@ def evaluate_only(
     if jobs < 1:
         raise ValueError(f"--jobs / evaluate_jobs: must be >= 1, got {jobs}")
     t0 = time.perf_counter()
-    runs = {p: runs_root / "evaluated" / p for p in found}
+    runs = {pair: runs_root / "evaluated" / shipped_name(*pair) for pair in found}
     hardware = bool(spec.get("hardware", True))
     _evaluate_parts(found, runs, overrides, hardware, jobs, log)
     report = root() / spec.get("report", f"reports/{spec['name']}")
@@ -150,38 +195,45 @@ def evaluate_only(
     training_table(runs).to_csv(report / "training.csv", index=False)
     seconds = time.perf_counter() - t0
     (report / "evaluate_only.json").write_text(
-        json.dumps({"policies": list(runs), "jobs": jobs, "seconds": round(seconds, 1)}, indent=1)
+        json.dumps(
+            {
+                "policies": [r.name for r in runs.values()],
+                "jobs": jobs,
+                "seconds": round(seconds, 1),
+            },
+            indent=1,
+        )
         + "\n"
     )
-    log(f"[lca] report: {index} ({len(runs)} policies, {seconds / 60:.1f} min)")
+    log(f"[lca] report: {index} ({len(runs)} trained policies, {seconds / 60:.1f} min)")
     return 0
 
 
 def _evaluate_parts(found, runs, overrides, hardware: bool, jobs: int, log) -> None:
-    """Every policy's cells, then every policy's hardware-style tasks, as one queue of parts:
+    """Every (policy, seed)'s cells, then every one's hardware-style tasks, as one queue of parts:
     in this process (`jobs` 1), or for `jobs` processes of one thread each, the longest parts
     first, so that no core idles while one policy's whole evaluation finishes alone. A
     hardware part runs in a copy of its own (a run directory is one process's at a time);
     its files then join the run's."""
     aside_root = next(iter(runs.values())).parent / ".hardware"
-    aside = {p: aside_root / p for p in found}
-    parts = [("cells", p, runs[p]) for p in found]
-    parts += [("hardware", p, aside[p]) for p in found] if hardware else []
+    aside = {key: aside_root / runs[key].name for key in found}
+    parts = [("cells", key, runs[key]) for key in found]
+    parts += [("hardware", key, aside[key]) for key in found] if hardware else []
     if jobs == 1:
-        for part, p, out in parts:
-            evaluate_part(part, p, found[p], out, overrides, 0, log)
+        for part, key, out in parts:
+            evaluate_part(part, key[0], found[key], out, overrides, 0, log)
     else:
         log(f"[lca] --evaluate-only: {len(found)} policies, {jobs} processes of 1 thread each")
         # spawn: a fork of a process that already ran torch's thread pool can deadlock
         context = multiprocessing.get_context("spawn")
         with ProcessPoolExecutor(jobs, mp_context=context) as pool:
             futures = [
-                pool.submit(evaluate_part, part, p, found[p], out, overrides, 1)
-                for part, p, out in parts
+                pool.submit(evaluate_part, part, key[0], found[key], out, overrides, 1)
+                for part, key, out in parts
             ]
             for future in futures:
                 future.result()  # a part's failure fails the command
     if hardware:
-        for p in found:
-            join_hardware(aside[p], runs[p])
+        for key in found:
+            join_hardware(aside[key], runs[key])
         shutil.rmtree(aside_root)

@@ -46,6 +46,7 @@ def run(overrides: list[str], log: Callable[[str], None] | None = print) -> dict
         spec = {
             **reference,
             "policies": names,
+            "seeds": [0],  # each folder ships as its name's seed-0 run
             "shipped": str(shipped),
             "report": str(Path(tmp, "report")),
             "hardware": params["hardware"] == "true",

@@ -53,8 +53,9 @@ def metric_table(ours: pd.DataFrame, paper: pd.DataFrame, metric: str) -> str:
     cells = [c for c in CELLS if any(k[1:3] == c for k in mine)]
     head = ["Policy", *(f"{t} {d}" for t, d in cells)]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    seeds = ours.groupby("policy")["n_seeds"].max() if "n_seeds" in ours else {}
     for policy in sorted(ours.policy.unique(), key=row_key):
-        row = [policy]
+        row = [_with_seeds(policy, seeds)]
         for terrain, difficulty in cells:
             value = mine.get((policy, terrain, difficulty, metric))
             text = "–" if value is None else f"{value:.{DIGITS[metric]}f}"
@@ -62,6 +63,12 @@ def metric_table(ours: pd.DataFrame, paper: pd.DataFrame, metric: str) -> str:
             row.append(text if quoted is None else f"{text} ({quoted:g})")
         lines.append("| " + " | ".join(row) + " |")
     return "\n".join(lines)
+
+
+def _with_seeds(policy: str, seeds) -> str:
+    """A policy's row label; one pooling several training seeds' units says how many."""
+    n = int(seeds.get(policy, 1))
+    return policy if n < 2 else f"{policy} ({n} seeds)"
 
 
 def _cell(table: pd.DataFrame, terrain: str, difficulty: str, metric: str) -> pd.DataFrame:
@@ -93,15 +100,17 @@ def claim_lines(claim: pd.DataFrame) -> str:
     verdict on the paper's claim (two-stage succeeds more, by ~10 points on uneven hard, and
     makes fewer contacts on stairs)."""
     lines = []
+    several = claim["seed"].nunique() > 1  # then each pair's bullets name their seed
     for terrain, difficulty, metric in CLAIMS:
         success = metric == "success"
         unit = "points" if success else "contacts/step"
         for r in _cell(claim, terrain, difficulty, metric).itertuples(index=False):
+            seed = f" (seed {r.seed})" if several else ""
             verdict = _verdict(r.ci_low, r.ci_high, better=1 if success else -1)
             if success and verdict == "seen":
                 verdict += ", " + _against_paper_gain(r.ci_low, r.ci_high)
             lines.append(
-                f"- {r.two_stage} − {r.one_stage}, {terrain} {difficulty}: "
+                f"- {r.two_stage} − {r.one_stage}{seed}, {terrain} {difficulty}: "
                 f"{r.diff:+.{DIGITS[metric]}f} {unit} "
                 f"[{r.ci_low:+.{DIGITS[metric]}f}, {r.ci_high:+.{DIGITS[metric]}f}]: {verdict}"
             )
