@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 
@@ -84,6 +85,7 @@ def test_evaluate_only_reports_two_shipped_policies(tmp_path):
         assert set(rows["metric"]) == metrics and (rows["n_units"] == 4 * seeds).all()
         assert (rows["n_seeds"] == seeds).all()
     assert (report / "claim.csv").is_file()  # the paired two-stage - one-stage comparison
+    assert json.loads((report / "evaluate_only.json").read_text())["rounds_reused"] == 0
     assert (report / "sim_table.tex").is_file() and (report / "index.html").is_file()
     training = pd.read_csv(report / "training.csv")
     assert list(zip(training["policy"], training["seed"], strict=True)) == [

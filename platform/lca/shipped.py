@@ -109,18 +109,23 @@ def _origin(run: Path) -> dict | None:
 
 def evaluate_part(
     part: str, policy: str, shipped: Path, out: Path, overrides: list[str], threads: int, log=print
-) -> None:
+) -> int:
     """One part of a shipped policy's evaluation into its own copy `out`: `cells` (the
     tables' results and clips) or `hardware` (the hardware-style tasks). `threads` > 0 pins
-    torch and the physics to that many threads."""
-    t0 = time.perf_counter()
+    torch and the physics to that many threads. Returns the rounds an earlier call had
+    finished and this one kept."""
+    t0, started = time.perf_counter(), time.time()
     set_torch_threads(threads)
     run = evaluated_copy(policy, shipped, out, overrides, threads)
+    reused = 0
     if part == "cells":
         evaluate_and_write(run, log=log)
+        reused = sum(f.stat().st_mtime < started for f in (run / "eval").glob("*/episode_*.csv"))
     else:
         run_hardware(run, load_run_config(run), log=log)
-    log(f"[lca] {policy}: {part} evaluated in {time.perf_counter() - t0:.0f} s")
+    kept = f" ({reused} rounds kept from an earlier call)" if reused else ""
+    log(f"[lca] {policy}: {part} evaluated in {time.perf_counter() - t0:.0f} s{kept}")
+    return reused
 
 
 def join_hardware(source: Path, run: Path) -> None:
@@ -189,39 +194,33 @@ def evaluate_only(
     t0 = time.perf_counter()
     runs = {pair: runs_root / "evaluated" / shipped_name(*pair) for pair in found}
     hardware = bool(spec.get("hardware", True))
-    _evaluate_parts(found, runs, overrides, hardware, jobs, log)
+    reused = _evaluate_parts(found, runs, overrides, hardware, jobs, log)
     report = root() / spec.get("report", f"reports/{spec['name']}")
     index = build_report(list(runs.values()), report)
     training_table(runs).to_csv(report / "training.csv", index=False)
     seconds = time.perf_counter() - t0
-    (report / "evaluate_only.json").write_text(
-        json.dumps(
-            {
-                "policies": [r.name for r in runs.values()],
-                "jobs": jobs,
-                "seconds": round(seconds, 1),
-            },
-            indent=1,
-        )
-        + "\n"
-    )
+    summary = {"policies": [r.name for r in runs.values()], "jobs": jobs}
+    # rounds an earlier, interrupted or smaller call had finished: a warm figure, not a cold one
+    summary |= {"rounds_reused": reused, "seconds": round(seconds, 1)}
+    (report / "evaluate_only.json").write_text(json.dumps(summary, indent=1) + "\n")
     log(f"[lca] report: {index} ({len(runs)} trained policies, {seconds / 60:.1f} min)")
     return 0
 
 
-def _evaluate_parts(found, runs, overrides, hardware: bool, jobs: int, log) -> None:
+def _evaluate_parts(found, runs, overrides, hardware: bool, jobs: int, log) -> int:
     """Every (policy, seed)'s cells, then every one's hardware-style tasks, as one queue of parts:
     in this process (`jobs` 1), or for `jobs` processes of one thread each, the longest parts
     first, so that no core idles while one policy's whole evaluation finishes alone. A
     hardware part runs in a copy of its own (a run directory is one process's at a time);
-    its files then join the run's."""
+    its files then join the run's. Returns the rounds kept from earlier calls."""
     aside_root = next(iter(runs.values())).parent / ".hardware"
     aside = {key: aside_root / runs[key].name for key in found}
     parts = [("cells", key, runs[key]) for key in found]
     parts += [("hardware", key, aside[key]) for key in found] if hardware else []
     if jobs == 1:
-        for part, key, out in parts:
-            evaluate_part(part, key[0], found[key], out, overrides, 0, log)
+        reused = [
+            evaluate_part(part, k[0], found[k], out, overrides, 0, log) for part, k, out in parts
+        ]
     else:
         log(f"[lca] --evaluate-only: {len(found)} policies, {jobs} processes of 1 thread each")
         # spawn: a fork of a process that already ran torch's thread pool can deadlock
@@ -231,9 +230,9 @@ def _evaluate_parts(found, runs, overrides, hardware: bool, jobs: int, log) -> N
                 pool.submit(evaluate_part, part, key[0], found[key], out, overrides, 1)
                 for part, key, out in parts
             ]
-            for future in futures:
-                future.result()  # a part's failure fails the command
+            reused = [future.result() for future in futures]  # a part's failure fails the command
     if hardware:
         for key in found:
             join_hardware(aside[key], runs[key])
         shutil.rmtree(aside_root)
+    return sum(reused)
