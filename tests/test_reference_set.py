@@ -87,6 +87,7 @@ def test_evaluate_only_reports_two_shipped_policies(tmp_path):
     assert (report / "claim.csv").is_file()  # the paired two-stage - one-stage comparison
     assert json.loads((report / "evaluate_only.json").read_text())["rounds_reused"] == 0
     assert (report / "sim_table.tex").is_file() and (report / "index.html").is_file()
+    assert "Between 1 and 2 training seeds per row" in (report / "index.html").read_text()
     training = pd.read_csv(report / "training.csv")
     assert list(zip(training["policy"], training["seed"], strict=True)) == [
         ("blind", 0),

@@ -90,3 +90,22 @@ def test_parity_is_seen_when_the_lowest_and_highest_cis_overlap() -> None:
 
 def test_parity_needs_two_policies() -> None:
     assert results.parity_lines(pd.DataFrame([sim_row("Blind", "stairs", 96.0, 2.0)])) == ""
+
+
+def test_rows_and_pairs_with_several_seeds_say_so() -> None:
+    """A row that pools two training seeds' units names the count, and with several seeds
+    each paired difference names its seed; one seed everywhere reads as before."""
+    ours = pd.DataFrame(
+        [sim_row("Blind", "stairs", 96.0, 2.0), sim_row("Two-Stage MLP", "stairs", 90.0, 2.0)]
+    )
+    ours["n_seeds"] = [1, 2]
+    table = results.metric_table(ours, pd.DataFrame(columns=ours.columns), "success")
+    assert "| Two-Stage MLP (2 seeds) | 90.0 |" in table and "| Blind | 96.0 |" in table
+    assert "Two-Stage MLP (2 seeds) 90.0 %" in results.parity_lines(ours)
+
+    first = claim_row("success", "uneven", "hard", (4.0, 16.0))
+    second = first | {"seed": 1, "ci_low": -2.0, "ci_high": 1.0}
+    lines = results.claim_lines(pd.DataFrame([first, second])).splitlines()
+    assert lines[0].startswith("- Two-Stage CNN − One-Stage CNN (seed 0), uneven hard: ")
+    assert lines[1].startswith("- Two-Stage CNN − One-Stage CNN (seed 1), uneven hard: ")
+    assert "(seed" not in results.claim_lines(pd.DataFrame([first]))

@@ -170,7 +170,15 @@ def seeds_section(seeds: pd.DataFrame, improvement: pd.DataFrame, n_seeds: int, 
     """Training seeds: per-seed values, mean and IQM across seeds with stratified bootstrap
     CIs, the probability of improvement, and the seed and performance-profile figures. With
     one seed it says so and claims nothing across seeds."""
-    if n_seeds < 2:
+    most = int(seeds["n_seeds"].max()) if not seeds.empty else 0
+    if n_seeds < 2 <= most:
+        head = (
+            f"<p>Between 1 and {most} training seeds per row (<code>n_seeds</code>): each seed's "
+            "mean over units, with the mean and IQM across seeds and their 95 % stratified "
+            "bootstrap CIs where a row has two or more. The tables pool each row's seeds' "
+            'units. <a href="seed_table.csv">CSV</a>.</p>'
+        )
+    elif n_seeds < 2:
         head = (
             "<p>One training seed per policy (at least one row): the tables show the spread "
             "across units; no confidence interval across seeds can be computed. Declare "

@@ -55,7 +55,7 @@ def metric_table(ours: pd.DataFrame, paper: pd.DataFrame, metric: str) -> str:
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     seeds = ours.groupby("policy")["n_seeds"].max() if "n_seeds" in ours else {}
     for policy in sorted(ours.policy.unique(), key=row_key):
-        row = [_with_seeds(policy, seeds)]
+        row = [_with_seeds(policy, seeds.get(policy, 1))]
         for terrain, difficulty in cells:
             value = mine.get((policy, terrain, difficulty, metric))
             text = "–" if value is None else f"{value:.{DIGITS[metric]}f}"
@@ -65,10 +65,9 @@ def metric_table(ours: pd.DataFrame, paper: pd.DataFrame, metric: str) -> str:
     return "\n".join(lines)
 
 
-def _with_seeds(policy: str, seeds) -> str:
+def _with_seeds(policy: str, n_seeds) -> str:
     """A policy's row label; one pooling several training seeds' units says how many."""
-    n = int(seeds.get(policy, 1))
-    return policy if n < 2 else f"{policy} ({n} seeds)"
+    return policy if int(n_seeds) < 2 else f"{policy} ({int(n_seeds)} seeds)"
 
 
 def _cell(table: pd.DataFrame, terrain: str, difficulty: str, metric: str) -> pd.DataFrame:
@@ -127,9 +126,10 @@ def parity_lines(ours: pd.DataFrame) -> str:
             continue
         low, high = rows.iloc[0], rows.iloc[-1]
         verdict = "seen (the CIs overlap)" if low.ci_high >= high.ci_low else "not seen"
+        name = {r.policy: _with_seeds(r.policy, r.get("n_seeds", 1)) for r in (low, high)}
         lines.append(
-            f"- Parity, {terrain} medium: {low.policy} {low['mean']:.1f} % "
-            f"[{low.ci_low:.1f}, {low.ci_high:.1f}] to {high.policy} {high['mean']:.1f} % "
+            f"- Parity, {terrain} medium: {name[low.policy]} {low['mean']:.1f} % "
+            f"[{low.ci_low:.1f}, {low.ci_high:.1f}] to {name[high.policy]} {high['mean']:.1f} % "
             f"[{high.ci_low:.1f}, {high.ci_high:.1f}]: {verdict}"
         )
     return "\n".join(lines)
