@@ -13,6 +13,8 @@ from omegaconf import OmegaConf
 
 from lca import experiment
 from lca.config import compose
+from lca.evaluate.policy import final_checkpoint, load_run_config
+from lca.evaluate.protocol import discard_stale_rounds
 from lca.paths import root
 from lca.shipped import evaluated_copy, shipped_name, shipped_runs
 
@@ -164,20 +166,27 @@ def test_an_evaluated_copy_keeps_its_rounds_only_from_the_same_origin(tmp_path):
     shipped = tmp_path / "shipped"
     _ship(shipped, "two_mlp")
     out = tmp_path / "runs" / "evaluated" / "two_mlp"
-    evaluated_copy("two_mlp", shipped / "two_mlp", out, ["scale=smoke"], threads=1)
+
+    def copy_and_stamp(threads: int) -> None:
+        """What an --evaluate-only part does before its rounds: the copy, then the stamp."""
+        evaluated_copy("two_mlp", shipped / "two_mlp", out, ["scale=smoke"], threads=threads)
+        cfg = load_run_config(out)
+        discard_stale_rounds(out / "eval", cfg, final_checkpoint(out), log=None)
+
+    copy_and_stamp(threads=1)
     finished = out / "eval" / "stairs-medium" / "episode_0.csv"
     finished.parent.mkdir(parents=True)
     finished.write_text("unit\n0\n")
 
-    evaluated_copy("two_mlp", shipped / "two_mlp", out, ["scale=smoke"], threads=1)
+    copy_and_stamp(threads=1)
     assert finished.read_text() == "unit\n0\n"
     assert OmegaConf.load(out / "config.yaml").sim.num_threads == 1
 
-    evaluated_copy("two_mlp", shipped / "two_mlp", out, ["scale=smoke"], threads=2)
+    copy_and_stamp(threads=2)
     assert not finished.exists()  # another thread count: evaluated afresh
     finished.parent.mkdir(parents=True)
     finished.write_text("unit\n0\n")
     checkpoint = next((shipped / "two_mlp" / "checkpoints").glob("*.pt"))
     checkpoint.write_bytes(checkpoint.read_bytes() + b"\0")
-    evaluated_copy("two_mlp", shipped / "two_mlp", out, ["scale=smoke"], threads=2)
+    copy_and_stamp(threads=2)
     assert not finished.exists()  # another checkpoint: evaluated afresh

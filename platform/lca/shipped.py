@@ -19,7 +19,6 @@ other steps its physics (reports/benchmarks.md).
 
 from __future__ import annotations
 
-import hashlib
 import itertools
 import json
 import multiprocessing
@@ -38,7 +37,7 @@ from lca.evaluate.run import evaluate_and_write
 from lca.paths import root
 from lca.report.build import build_report
 from lca.report.reference import copy_run
-from lca.store import COMPLETE, atomic_write, cpu_model
+from lca.store import COMPLETE
 
 
 def shipped_dir(spec: dict) -> Path:
@@ -75,36 +74,22 @@ def evaluated_copy(
     policy: str, shipped: Path, out: Path, overrides: list[str], threads: int = 0
 ) -> Path:
     """A fresh run directory `out` holding `shipped`'s policy, with the evaluation and
-    hardware settings of `policy=<policy> <overrides>` (and `threads` physics threads).
-    Finished rounds of an earlier copy stay when they came from the same checkpoint, thread
-    count and CPU (the three that change results; the rounds' own stamp covers the
-    evaluation settings), so an interrupted or extended evaluation goes on where it was."""
+    hardware settings of `policy=<policy> <overrides>` (and `threads` physics threads). An
+    earlier copy's finished rounds stay: the evaluation reuses those its stamp still matches
+    (`lca.evaluate.protocol.discard_stale_rounds`), so an interrupted or extended evaluation
+    goes on where it was."""
     composed = compose([f"policy={policy}", *overrides])
     evaluation = OmegaConf.merge(composed.eval, {"reference": []})
     sim = {"num_threads": threads} if threads else {}
-    checkpoint = final_checkpoint(shipped)
-    origin = {
-        "checkpoint_sha256": hashlib.sha256(checkpoint.read_bytes()).hexdigest(),
-        "threads": threads,
-        "cpu": cpu_model(),
-    }
     rounds, kept = out / "eval", out.parent / f".{out.name}.eval"
-    if rounds.is_dir() and _origin(out) == origin:
+    if rounds.is_dir():
         shutil.rmtree(kept, ignore_errors=True)
         rounds.replace(kept)
+    checkpoint = final_checkpoint(shipped)
     copy_run(shipped, out, checkpoint, eval=evaluation, hardware=composed.hardware, sim=sim)
     if kept.is_dir():
         kept.replace(rounds)
-    atomic_write(out / ORIGIN, json.dumps(origin, indent=1) + "\n")
     return out
-
-
-ORIGIN = "evaluated_from.json"  # what an evaluated copy's rounds came from
-
-
-def _origin(run: Path) -> dict | None:
-    path = run / ORIGIN
-    return json.loads(path.read_text()) if path.is_file() else None
 
 
 def evaluate_part(

@@ -9,6 +9,7 @@ first missing round and never counts a round twice.
 from __future__ import annotations
 
 import copy
+import hashlib
 import json
 import shutil
 import time
@@ -26,7 +27,7 @@ from lca.evaluate.metrics import episode_metrics
 from lca.evaluate.policy import final_checkpoint, load_policy, sees_map
 from lca.evaluate.rollout import rollout, start, step_only
 from lca.evaluate.terrains import eval_mixture
-from lca.store import atomic_write
+from lca.store import atomic_write, cpu_model
 from lca.task.env import LocomotionEnv
 from lca.testhook import exit_point
 
@@ -112,7 +113,7 @@ def evaluate_run(run_dir: Path, cfg: DictConfig, log=print) -> pd.DataFrame:
     checkpoint = final_checkpoint(run_dir)
     perception = sees_map(checkpoint)
     out_dir = run_dir / "eval"
-    _discard_stale_rounds(out_dir, ev, log)
+    discard_stale_rounds(out_dir, cfg, checkpoint, log)
     written = 0
     for cell in ev.cells:
         name = cell_name(cell)
@@ -150,12 +151,18 @@ NOT_PROTOCOL = ("videos", "video_seconds")  # eval keys that do not change the r
 PROTOCOL_VERSION = 2
 
 
-def _discard_stale_rounds(out_dir: Path, ev, log) -> None:
-    """Finished rounds are reused only under the same protocol; otherwise start afresh."""
-    protocol = OmegaConf.to_container(ev, resolve=True)
+def discard_stale_rounds(out_dir: Path, cfg: DictConfig, checkpoint: Path, log=print) -> None:
+    """Finished rounds are reused only under the same protocol, checkpoint, configured physics
+    threads and CPU (the last two change rounding, and over 1000 steps some falls:
+    reports/benchmarks.md); otherwise start afresh. The process's torch threads are not
+    stamped: `python -m lca.evaluate` leaves them at torch's default."""
+    protocol = OmegaConf.to_container(cfg.eval, resolve=True)
     for key in NOT_PROTOCOL:
         protocol.pop(key, None)
     protocol["protocol_version"] = PROTOCOL_VERSION
+    protocol["checkpoint_sha256"] = hashlib.sha256(Path(checkpoint).read_bytes()).hexdigest()
+    protocol["sim_threads"] = int(cfg.sim.num_threads)
+    protocol["cpu"] = cpu_model()
     settings = json.dumps(protocol, sort_keys=True)
     stamp = out_dir / "protocol.json"
     if out_dir.exists() and (not stamp.exists() or stamp.read_text() != settings):
