@@ -69,8 +69,9 @@ def sweep_command(spec: dict, extra: list[str], runs_root: str) -> list[str]:
     ]
 
 
-def estimate_seconds(overrides: list[str]) -> dict:
-    """Cost of one run from the measured benchmark throughput (reports/bench/*.json)."""
+def estimate_seconds(overrides: list[str], train_rate: float | None = None) -> dict:
+    """Cost of one run from the measured benchmark throughput (reports/bench/*.json), or
+    from `train_rate` (environment steps a second) where the policy's own runs measured it."""
     cfg = compose(overrides)
     train_steps = cfg.scale.max_iterations * cfg.algo.num_steps_per_env * cfg.task.num_envs
     ev = cfg.eval
@@ -80,15 +81,59 @@ def estimate_seconds(overrides: list[str]) -> dict:
     suffix = "_warp" if cfg.sim.backend == "warp" else ""  # the chosen backend's own rates
     train, env = BENCH_DIR / f"train{suffix}.json", BENCH_DIR / f"env{suffix}.json"
     if train.exists() and env.exists():
-        train_rate = json.loads(train.read_text())["steps_per_s"]
         rows = json.loads(env.read_text())["batched"]
         eval_rate = max(r["steps_per_s"] for r in rows)
         out |= {
-            "train_steps_per_s": train_rate,
+            "train_steps_per_s": train_rate or json.loads(train.read_text())["steps_per_s"],
             "eval_steps_per_s": eval_rate,
-            "seconds": train_steps / train_rate + eval_steps / eval_rate,
+            "measured_by_runs": train_rate is not None,
         }
+        out["seconds"] = train_steps / out["train_steps_per_s"] + eval_steps / eval_rate
     return out
+
+
+def print_plan(spec: dict, sweeps: list[dict], extra: list[str], runs_root: str, rates: dict):
+    """`--dry-run`: every planned run, its environment steps and cost, and the commands.
+    `rates`: policy -> training steps/s its shipped runs measured (the benchmark's otherwise:
+    the CNN pair trains ~4x slower than the MLP the benchmark measures)."""
+    plan = [pair for s in sweeps for pair in itertools.product(s["policies"], s["seeds"])]
+    for policy, seed in plan:
+        print(f"  policy={policy} seed={seed} {' '.join(spec['overrides'] + extra)}")
+    costs = {
+        p: estimate_seconds([f"policy={p}", *spec["overrides"], *extra], rates.get(p))
+        for p in dict.fromkeys(p for p, _ in plan)
+    }
+    cost = costs[plan[0][0]]
+    print(f"{len(plan)} runs into {runs_root}/ with launcher '{spec['launcher']}'")
+    print(
+        f"per run: {cost['train_env_steps']:,} training + {cost['eval_env_steps']:,} "
+        "evaluation env steps"
+    )
+    if spec["table"] == "hardware":
+        print("then: `python -m lca.hardware` on each run (4 tasks x trials), and the report")
+    if "seconds" not in cost:
+        print(
+            "estimated cost: unknown (run `python -m lca.bench train` and `python -m "
+            f"lca.bench env` with sim.backend={cost['backend']} to measure throughput)"
+        )
+    elif any(c["measured_by_runs"] for c in costs.values()):
+        total = sum(costs[p]["seconds"] for p, _ in plan)
+        each = ", ".join(
+            f"{p} {c['seconds'] / 3600:.2f} h ({c['train_steps_per_s']:,.0f} steps/s, "
+            f"{'its shipped runs' if c['measured_by_runs'] else '`python -m lca.bench train`'})"
+            for p, c in costs.items()
+        )
+        print(f"estimated cost: {total / 3600:.1f} core-pair hours in all; per run: {each}")
+    else:
+        total = cost["seconds"] * len(plan)
+        print(
+            f"estimated cost: {cost['seconds'] / 3600:.2f} h per run, {total / 3600:.1f} "
+            f"core-pair hours in all (from {cost['train_steps_per_s']:,.0f} training and "
+            f"{cost['eval_steps_per_s']:,.0f} evaluation steps/s measured by "
+            f"`python -m lca.bench train|env` with sim.backend={cost['backend']})"
+        )
+    for s in sweeps:
+        print("command:", " ".join(sweep_command(s, extra, runs_root)))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -118,45 +163,20 @@ def main(argv: list[str] | None = None) -> int:
         from lca.shipped import evaluate_only
 
         return evaluate_only(spec, spec["overrides"] + extra, Path(REPO, runs_root), jobs=args.jobs)
-    sweeps = [spec]
+    sweeps, rates = [spec], {}
     if "shipped" in spec:  # a (policy, seed) that ships is not trained again
-        from lca.shipped import shipped_name, shipped_runs
+        from lca.shipped import shipped_name, shipped_runs, training_rates
 
         done = shipped_runs(spec)
         if done:
             names = ", ".join(shipped_name(*pair) for pair in done)
             print(f"[lca] shipped already, not trained again: {names}")
-        sweeps = missing_sweeps(spec, set(done))
+        sweeps, rates = missing_sweeps(spec, set(done)), training_rates(done)
         if not sweeps:
             print("[lca] every policy ships: nothing to train (--evaluate-only reports them)")
             return 0
     if args.dry_run:
-        plan = [pair for s in sweeps for pair in itertools.product(s["policies"], s["seeds"])]
-        for policy, seed in plan:
-            print(f"  policy={policy} seed={seed} {' '.join(spec['overrides'] + extra)}")
-        cost = estimate_seconds([f"policy={plan[0][0]}", *spec["overrides"], *extra])
-        print(f"{len(plan)} runs into {runs_root}/ with launcher '{spec['launcher']}'")
-        print(
-            f"per run: {cost['train_env_steps']:,} training + {cost['eval_env_steps']:,} "
-            "evaluation env steps"
-        )
-        if spec["table"] == "hardware":
-            print("then: `python -m lca.hardware` on each run (4 tasks x trials), and the report")
-        if "seconds" in cost:
-            total = cost["seconds"] * len(plan)
-            print(
-                f"estimated cost: {cost['seconds'] / 3600:.2f} h per run, {total / 3600:.1f} "
-                f"core-pair hours in all (from {cost['train_steps_per_s']:,.0f} training and "
-                f"{cost['eval_steps_per_s']:,.0f} evaluation steps/s measured by "
-                f"`python -m lca.bench train|env` with sim.backend={cost['backend']})"
-            )
-        else:
-            print(
-                "estimated cost: unknown (run `python -m lca.bench train` and `python -m "
-                f"lca.bench env` with sim.backend={cost['backend']} to measure throughput)"
-            )
-        for s in sweeps:
-            print("command:", " ".join(sweep_command(s, extra, runs_root)))
+        print_plan(spec, sweeps, extra, runs_root, rates)
         return 0
     training = [o for o in extra if not o.startswith("hardware.")]  # not part of a run's identity
     code = 0

@@ -147,6 +147,16 @@ def training_table(runs: dict[tuple[str, int], Path]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def training_rates(runs: dict[tuple[str, int], Path]) -> dict[str, float]:
+    """Each policy's training rate, environment steps a second over its whole run (its
+    curve's last row), the median over its shipped seeds."""
+    table = training_table(runs)
+    if table.empty:
+        return {}
+    rates = table["env_steps"] / table["wall_s"]
+    return {p: float(r) for p, r in rates.groupby(table["policy"]).median().items()}
+
+
 def _run_steps(run: Path) -> int:
     """The environment steps a run's curve ends at (0 without a curve)."""
     curve = run / "train_curve.csv"

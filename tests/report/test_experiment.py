@@ -125,3 +125,46 @@ def test_hardware_experiment_plan() -> None:
     assert planned == [("blind", "0"), ("one_mlp", "0"), ("two_cnn", "0"), ("two_mlp", "0")]
     assert "4 runs into runs/paper_sim/" in out  # shares the simulation table's trained runs
     assert "then: `python -m lca.hardware` on each run" in out
+
+
+def test_dry_run_costs_a_policy_at_its_shipped_runs_rate(tmp_path, capsys) -> None:
+    """A policy with a shipped seed is costed at that run's own training rate (the CNN pair
+    trains ~4x slower than the benchmark's MLP), the others at the benchmark's."""
+    import shutil
+
+    source = REPO / "assets" / "policies" / "one_cnn"
+    folder = tmp_path / "shipped" / "one_cnn"
+    folder.mkdir(parents=True)
+    for name in ("COMPLETE", "config.yaml", "train_curve.csv"):
+        shutil.copy(source / name, folder / name)
+    spec = {
+        "name": "costs",
+        "policies": ["blind", "one_cnn"],
+        "seeds": [0, 1],
+        "overrides": ["scale=reference"],
+        "shipped": str(tmp_path / "shipped"),
+    }
+    (tmp_path / "costs.yaml").write_text(OmegaConf.to_yaml(spec))
+    assert experiment.main([str(tmp_path / "costs.yaml"), "--dry-run"]) == 0
+    out = capsys.readouterr().out
+    planned = re.findall(r"^  policy=(\w+) seed=(\d+)", out, flags=re.M)
+    assert planned == [("blind", "0"), ("blind", "1"), ("one_cnn", "1")]
+
+    import pandas as pd
+
+    last = pd.read_csv(folder / "train_curve.csv").iloc[-1]
+    cnn_rate = last["env_steps"] / round(float(last["wall_s"]), 1)
+    bench_rate = json.loads((REPO / "reports" / "bench" / "train.json").read_text())["steps_per_s"]
+    eval_rate = max(
+        r["steps_per_s"]
+        for r in json.loads((REPO / "reports" / "bench" / "env.json").read_text())["batched"]
+    )
+    train, evaluation = _expected_steps("scale=reference")
+    cnn_h = (train / cnn_rate + evaluation / eval_rate) / 3600
+    blind_h = (train / bench_rate + evaluation / eval_rate) / 3600
+    assert cnn_h > 2 * blind_h  # what the single benchmark rate hid
+    assert (
+        f"estimated cost: {(2 * blind_h + cnn_h):.1f} core-pair hours in all; per run: "
+        f"blind {blind_h:.2f} h ({bench_rate:,.0f} steps/s, `python -m lca.bench train`), "
+        f"one_cnn {cnn_h:.2f} h ({cnn_rate:,.0f} steps/s, its shipped runs)"
+    ) in out
