@@ -149,8 +149,8 @@ def training_table(runs: dict[tuple[str, int], Path]) -> pd.DataFrame:
 
 def training_rates(runs: dict[tuple[str, int], Path]) -> dict[str, float]:
     """Each policy's training rate, environment steps a second over its whole run (its
-    curve's last row), the median over its shipped seeds."""
-    table = training_table(runs)
+    curve's last row), the median over its shipped seeds that have a curve."""
+    table = training_table({k: r for k, r in runs.items() if (r / "train_curve.csv").exists()})
     if table.empty:
         return {}
     rates = table["env_steps"] / table["wall_s"]
