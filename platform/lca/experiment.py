@@ -92,7 +92,9 @@ def estimate_seconds(overrides: list[str], train_rate: float | None = None) -> d
     return out
 
 
-def print_plan(spec: dict, sweeps: list[dict], extra: list[str], runs_root: str, rates: dict):
+def print_plan(
+    spec: dict, sweeps: list[dict], extra: list[str], runs_root: str, rates: dict
+) -> None:
     """`--dry-run`: every planned run, its environment steps and cost, and the commands.
     `rates`: policy -> training steps/s its shipped runs measured (the benchmark's otherwise:
     the CNN pair trains ~4x slower than the MLP the benchmark measures)."""
