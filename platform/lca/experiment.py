@@ -86,7 +86,6 @@ def estimate_seconds(overrides: list[str], train_rate: float | None = None) -> d
         out |= {
             "train_steps_per_s": train_rate or json.loads(train.read_text())["steps_per_s"],
             "eval_steps_per_s": eval_rate,
-            "measured_by_runs": train_rate is not None,
         }
         out["seconds"] = train_steps / out["train_steps_per_s"] + eval_steps / eval_rate
     return out
@@ -118,11 +117,11 @@ def print_plan(
             "estimated cost: unknown (run `python -m lca.bench train` and `python -m "
             f"lca.bench env` with sim.backend={cost['backend']} to measure throughput)"
         )
-    elif any(c["measured_by_runs"] for c in costs.values()):
+    elif rates.keys() & costs.keys():
         total = sum(costs[p]["seconds"] for p, _ in plan)
         each = ", ".join(
             f"{p} {c['seconds'] / 3600:.2f} h ({c['train_steps_per_s']:,.0f} steps/s, "
-            f"{'its shipped runs' if c['measured_by_runs'] else '`python -m lca.bench train`'})"
+            f"{'its shipped runs' if p in rates else '`python -m lca.bench train`'})"
             for p, c in costs.items()
         )
         print(f"estimated cost: {total / 3600:.1f} core-pair hours in all; per run: {each}")
@@ -165,20 +164,22 @@ def main(argv: list[str] | None = None) -> int:
         from lca.shipped import evaluate_only
 
         return evaluate_only(spec, spec["overrides"] + extra, Path(REPO, runs_root), jobs=args.jobs)
-    sweeps, rates = [spec], {}
+    sweeps, done = [spec], {}
     if "shipped" in spec:  # a (policy, seed) that ships is not trained again
-        from lca.shipped import shipped_name, shipped_runs, training_rates
+        from lca.shipped import shipped_name, shipped_runs
 
         done = shipped_runs(spec)
         if done:
             names = ", ".join(shipped_name(*pair) for pair in done)
             print(f"[lca] shipped already, not trained again: {names}")
-        sweeps, rates = missing_sweeps(spec, set(done)), training_rates(done)
+        sweeps = missing_sweeps(spec, set(done))
         if not sweeps:
             print("[lca] every policy ships: nothing to train (--evaluate-only reports them)")
             return 0
     if args.dry_run:
-        print_plan(spec, sweeps, extra, runs_root, rates)
+        from lca.shipped import training_rates
+
+        print_plan(spec, sweeps, extra, runs_root, training_rates(done))
         return 0
     training = [o for o in extra if not o.startswith("hardware.")]  # not part of a run's identity
     code = 0
