@@ -28,6 +28,7 @@ from lca.learn.command_curriculum import CommandCurriculum
 from lca.learn.episode_stats import EpisodeStats
 from lca.learn.exploration import apply_ceiling, noise_ceiling, set_initial_stds
 from lca.learn.export import export_jit, export_onnx
+from lca.learn.interrupt import StopOnSignal, TrainingInterrupted
 from lca.learn.reward_curriculum import RewardCurriculum
 from lca.learn.train_cfg import build_train_cfg
 from lca.learn.variants import actor_spec
@@ -227,7 +228,8 @@ class Trainer(Checkpoints):
         t_start = time.perf_counter()
         try:
             self.runner.logger.init_logging_writer()
-            final = self._loop(writer, curve, stats, switch, obs, t_start, num_steps, hook)
+            with StopOnSignal() as self.stop:
+                final = self._loop(writer, curve, stats, switch, obs, t_start, num_steps, hook)
             stage = curriculum.stage_name(cfg.curriculum, final, self.total)
             self.save(f"final_{stage}.pt", final, upload=True)
             self.save(LATEST, final)
@@ -363,6 +365,9 @@ class Trainer(Checkpoints):
             if (it + 1) % cfg.scale.checkpoint_interval == 0:
                 self.save(LATEST, it)
             exit_point("iteration", it)
+            if self.stop.signum is not None:
+                self.save(LATEST, it)
+                raise TrainingInterrupted(self.stop.signum, it)
             if hook is not None:
                 t_hook = time.perf_counter()
                 stop = hook(self, it, row)
