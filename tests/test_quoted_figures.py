@@ -60,6 +60,7 @@ LEARNING_ROWS = {
     "Q1, Two-Stage MLP, seed 1": "two_mlp-seed1",
     "Q1, Blind, seed 1": "blind-seed1",
     "Q1, One-Stage CNN, seed 1": "one_cnn-seed1",
+    "Q1, Two-Stage CNN, seed 1": "two_cnn-seed1",
 }
 LEARNING_CELLS = [("flat", "medium"), ("stairs", "medium"), ("stairs", "hard")]
 LEARNING_CELLS += [("uneven", "medium"), ("uneven", "hard")]
