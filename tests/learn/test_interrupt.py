@@ -58,6 +58,7 @@ def test_sigterm_saves_the_iteration_in_progress(tmp_path) -> None:
     assert proc.returncode == 128 + signal.SIGTERM, out[-3000:]
     assert "SIGTERM: stopping after this iteration" in out
     last = int(read_curve(curve)[-1]["iteration"])
+    assert f"training stopped after iteration {last}, saved in" in out
     assert 2 <= last < 399
     saved = torch.load(run / "checkpoints" / "latest.pt", weights_only=False, map_location="cpu")
     assert saved["iter"] == last, out[-3000:]

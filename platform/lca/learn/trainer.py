@@ -367,7 +367,9 @@ class Trainer(Checkpoints):
             exit_point("iteration", it)
             if self.stop.signum is not None:
                 self.save(LATEST, it)
-                raise TrainingInterrupted(self.stop.signum, it)
+                interrupted = TrainingInterrupted(self.stop.signum, it)
+                print(f"[lca] {interrupted}", flush=True)  # SystemExit prints only its code
+                raise interrupted
             if hook is not None:
                 t_hook = time.perf_counter()
                 stop = hook(self, it, row)
