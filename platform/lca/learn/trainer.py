@@ -362,11 +362,10 @@ class Trainer(Checkpoints):
                     f" | lr {row['learning_rate']:.1e} | ETA {_fmt_eta(eta)}",
                     flush=True,
                 )
-            if (it + 1) % cfg.scale.checkpoint_interval == 0:
+            if (it + 1) % cfg.scale.checkpoint_interval == 0 or self.stop.signum is not None:
                 self.save(LATEST, it)
             exit_point("iteration", it)
             if self.stop.signum is not None:
-                self.save(LATEST, it)
                 interrupted = TrainingInterrupted(self.stop.signum, it)
                 print(f"[lca] {interrupted}", flush=True)  # SystemExit prints only its code
                 raise interrupted
